@@ -1,0 +1,39 @@
+//! Skeleton Climbing isosurface extraction.
+//!
+//! The core ([`sweep`]) is `no_std` and allocation-free: it walks a grid layer by layer with
+//! O(nx·ny) caller-provided scratch and hands vertices and triangles to a [`Sink`]. With the
+//! `alloc` feature, [`extract`] builds an indexed [`Mesh`] and [`SliceStreamer`] meshes a volume
+//! fed one z-slice at a time; with `std` (default), [`extract_par`] splits the z range over threads
+//! and produces a byte-identical mesh for any thread count.
+#![no_std]
+#![warn(missing_docs)]
+
+#[cfg(feature = "alloc")]
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
+extern crate self as sc_runtime;
+
+mod error;
+mod params;
+mod scalar;
+pub mod tables;
+
+pub use error::Error;
+pub use params::{Mode, Params, Volume};
+pub use scalar::Scalar;
+mod stats;
+pub use stats::Stats;
+
+#[cfg(feature = "alloc")]
+mod mesh;
+#[cfg(feature = "alloc")]
+pub use mesh::{Mesh, extract};
+
+#[cfg(feature = "std")]
+pub mod demo;
+#[cfg(feature = "std")]
+mod parallel;
+#[cfg(feature = "std")]
+pub use parallel::extract_par;

@@ -1,0 +1,66 @@
+use crate::{Error, Scalar};
+
+/// Which steps of Skeleton Climbing run (SPEC §5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Mode {
+    /// Steps 1–4, merging only grey edges that keep the surface a closed 2-manifold.
+    #[default]
+    Embedded,
+    /// Steps 1–4 as the paper does: every occupied interior grey edge is merged.
+    Paper,
+    /// Steps 1–3 only: the Marching-Cubes-sized surface, no merging.
+    Steps123,
+}
+
+/// Everything about an extraction besides the samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Params {
+    /// Samples `>= iso` are filled; NaN is empty.
+    pub iso: f64,
+    /// Which steps run.
+    pub mode: Mode,
+    /// Emit per-vertex normals (negated, normalised central-difference gradients).
+    pub normals: bool,
+    /// World distance between samples along x, y, z.
+    pub spacing: [f64; 3],
+    /// World position of sample `(0, 0, 0)`.
+    pub origin: [f64; 3],
+}
+
+impl Params {
+    /// Embedded mode, with normals, unit spacing and the origin at zero.
+    pub fn new(iso: f64) -> Self {
+        Params { iso, mode: Mode::Embedded, normals: true, spacing: [1.0; 3], origin: [0.0; 3] }
+    }
+}
+
+/// A borrowed grid of samples, x fastest: `data[x + nx * (y + ny * z)]`.
+#[derive(Clone, Copy, Debug)]
+pub struct Volume<'a, T> {
+    data: &'a [T],
+    dims: [usize; 3],
+}
+
+impl<'a, T: Scalar> Volume<'a, T> {
+    /// Checks that `data` holds exactly `nx · ny · nz` samples.
+    pub fn new(data: &'a [T], dims: [usize; 3]) -> Result<Self, Error> {
+        let expected = dims
+            .iter()
+            .try_fold(1usize, |acc, &d| acc.checked_mul(d))
+            .ok_or(Error::DimsOverflow(dims))?;
+        if data.len() != expected {
+            return Err(Error::DataLength { expected, actual: data.len() });
+        }
+        Ok(Volume { data, dims })
+    }
+
+    /// The samples, x fastest.
+    pub fn data(&self) -> &'a [T] {
+        self.data
+    }
+
+    /// `[nx, ny, nz]`.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+}
