@@ -31,7 +31,13 @@ impl DemoVolume {
                 }
             }
         }
-        DemoVolume { data, dims: [n; 3], iso, spacing: [step; 3], origin: [coord(0); 3] }
+        DemoVolume {
+            data,
+            dims: [n; 3],
+            iso,
+            spacing: [step; 3],
+            origin: [coord(0); 3],
+        }
     }
 }
 
@@ -53,7 +59,9 @@ pub fn knot_field(x: f64, y: f64, z: f64) -> f64 {
 
 /// A ball of radius 0.8 in `[-1, 1]³`, as signed distance (positive inside).
 pub fn sphere(n: usize) -> DemoVolume {
-    DemoVolume::sample(n, -1.0, 1.0, 0.0, |x, y, z| 0.8 - (x * x + y * y + z * z).sqrt())
+    DemoVolume::sample(n, -1.0, 1.0, 0.0, |x, y, z| {
+        0.8 - (x * x + y * y + z * z).sqrt()
+    })
 }
 
 /// A ring torus (radii 0.6 and 0.25) around the z axis in `[-1, 1]³` (positive inside).
@@ -72,7 +80,11 @@ pub fn sphere_noise(n: usize) -> DemoVolume {
     for (i, f) in v.data.iter_mut().enumerate() {
         let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
         let border = x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1;
-        *f = if border { -1.0 } else { *f + 0.05 * unit_noise(i as u64) };
+        *f = if border {
+            -1.0
+        } else {
+            *f + 0.05 * unit_noise(i as u64)
+        };
     }
     v
 }

@@ -30,13 +30,21 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::DimsOverflow(d) => {
-                write!(f, "dimensions {}x{}x{} overflow the address space", d[0], d[1], d[2])
+                write!(
+                    f,
+                    "dimensions {}x{}x{} overflow the address space",
+                    d[0], d[1], d[2]
+                )
             }
             Error::DataLength { expected, actual } => {
                 write!(f, "expected {expected} samples, got {actual}")
             }
-            Error::TooManyVertices => f.write_str("the mesh would exceed u32::MAX vertices or triangles"),
-            Error::ScratchTooSmall => f.write_str("scratch buffers are too small for these dimensions"),
+            Error::TooManyVertices => {
+                f.write_str("the mesh would exceed u32::MAX vertices or triangles")
+            }
+            Error::ScratchTooSmall => {
+                f.write_str("scratch buffers are too small for these dimensions")
+            }
             Error::SliceLength { expected, actual } => {
                 write!(f, "expected a slice of {expected} samples, got {actual}")
             }

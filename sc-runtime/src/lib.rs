@@ -31,9 +31,21 @@ mod mesh;
 #[cfg(feature = "alloc")]
 pub use mesh::{Mesh, extract};
 
+mod extract;
+mod stream;
+pub use extract::extract_into;
+pub use stream::SliceStreamer;
+
 #[cfg(feature = "std")]
 pub mod demo;
 #[cfg(feature = "std")]
 mod parallel;
 #[cfg(feature = "std")]
 pub use parallel::extract_par;
+
+mod scratch;
+mod sink;
+mod sweep;
+mod vertex;
+pub use scratch::{Scratch, ScratchLen};
+pub use sink::Sink;

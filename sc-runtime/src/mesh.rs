@@ -1,6 +1,7 @@
+use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::{Error, Params, Scalar, Stats, Volume};
+use crate::{Error, Params, Scalar, Scratch, Sink, Stats, Volume, extract_into};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -15,8 +16,58 @@ pub struct Mesh {
     pub stats: Stats,
 }
 
+impl Sink for Mesh {
+    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
+        self.positions.push(position);
+        if let Some(n) = normal {
+            self.normals.push(n);
+        }
+    }
+
+    fn triangle(&mut self, triangle: [u32; 3]) {
+        self.triangles.push(triangle);
+    }
+}
+
+/// Scratch buffers owned on the heap.
+pub(crate) struct OwnedScratch {
+    bytes: Vec<u8>,
+    words: Vec<u32>,
+    dims: [usize; 3],
+}
+
+impl OwnedScratch {
+    pub fn new(dims: [usize; 3]) -> Result<Self, Error> {
+        let len = Scratch::len(dims)?;
+        Ok(OwnedScratch {
+            bytes: vec![0; len.bytes],
+            words: vec![0; len.words],
+            dims,
+        })
+    }
+
+    pub fn lend(&mut self) -> Scratch<'_> {
+        Scratch {
+            bytes: &mut self.bytes,
+            words: &mut self.words,
+        }
+        .checked(self.dims)
+    }
+}
+
 /// Extracts the surface on one thread.
+///
+/// ```
+/// use sc_runtime::{Params, Volume, demo, extract};
+///
+/// let knot = demo::knot(64);
+/// let params = Params { spacing: knot.spacing, origin: knot.origin, ..Params::new(knot.iso) };
+/// let mesh = extract(&Volume::new(&knot.data, knot.dims).unwrap(), &params).unwrap();
+/// assert_eq!(mesh.stats.t13, 13_968); // the paper's Table 1, Steps 1–3
+/// ```
 pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
-    let _ = (volume, params);
-    todo!("runtime in progress")
+    let mut scratch = OwnedScratch::new(volume.dims())?;
+    let mut mesh = Mesh::default();
+    mesh.stats = extract_into(volume, params, scratch.lend(), &mut mesh)?;
+    Ok(mesh)
 }

@@ -13,7 +13,7 @@ pub enum Mode {
 }
 
 /// Everything about an extraction besides the samples.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 pub struct Params {
     /// Samples `>= iso` are filled; NaN is empty.
     pub iso: f64,
@@ -25,12 +25,21 @@ pub struct Params {
     pub spacing: [f64; 3],
     /// World position of sample `(0, 0, 0)`.
     pub origin: [f64; 3],
+    /// The case tables; [`crate::tables::DEFAULT`] unless a crate brings its own.
+    pub tables: &'static crate::tables::CaseTables,
 }
 
 impl Params {
     /// Embedded mode, with normals, unit spacing and the origin at zero.
     pub fn new(iso: f64) -> Self {
-        Params { iso, mode: Mode::Embedded, normals: true, spacing: [1.0; 3], origin: [0.0; 3] }
+        Params {
+            iso,
+            mode: Mode::Embedded,
+            normals: true,
+            spacing: [1.0; 3],
+            origin: [0.0; 3],
+            tables: &crate::tables::DEFAULT,
+        }
     }
 }
 
@@ -49,7 +58,10 @@ impl<'a, T: Scalar> Volume<'a, T> {
             .try_fold(1usize, |acc, &d| acc.checked_mul(d))
             .ok_or(Error::DimsOverflow(dims))?;
         if data.len() != expected {
-            return Err(Error::DataLength { expected, actual: data.len() });
+            return Err(Error::DataLength {
+                expected,
+                actual: data.len(),
+            });
         }
         Ok(Volume { data, dims })
     }

@@ -59,5 +59,9 @@ float_scalar!(f32, f64);
 /// `ceil` saturated to `i64`, without `std`: the `as` cast truncates toward zero and saturates.
 fn libm_ceil(x: f64) -> i64 {
     let t = x as i64;
-    if (t as f64) < x { t.saturating_add(1) } else { t }
+    if (t as f64) < x {
+        t.saturating_add(1)
+    } else {
+        t
+    }
 }

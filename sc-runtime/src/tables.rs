@@ -1,1 +1,64 @@
-//! Case tables.
+//! Case tables as static data, produced at compile time by [`sc_macros::include_tables!`].
+//!
+//! The default set, [`DEFAULT`], comes from the committed `tables/skeleton-climbing.ron`. A crate
+//! can build its own set (say, with another nibbling order) in `build.rs` with `sc_tablegen`, and
+//! include it the same way; see the `custom-tables` example crate.
+
+/// Marks a grey axis without an ear in [`Entry::ears`].
+pub const NO_EAR: u8 = 0xFF;
+
+/// One class-and-case entry, packed for the extraction loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Entry {
+    /// Triangles as edge-id triples; only the first `count` are used. Ear triangles are stored
+    /// with their grey edge in the middle, `[back, grey, forward]`.
+    pub tris: [[u8; 3]; 5],
+    /// Number of triangles.
+    pub count: u8,
+    /// Per grey axis (x, y, z): index of the grey edge's ear in `tris`, or [`NO_EAR`].
+    pub ears: [u8; 3],
+    /// Bit `axis` set iff that grey edge is occupied and mergeable.
+    pub mergeable: u8,
+}
+
+/// The two 2048-entry tables: the embedded one (Steps 1–3 and Embedded mode) and the paper one
+/// (forced folds nibbled greys-first anyway, for Paper mode). Index: `class * 256 + case`.
+#[derive(Debug)]
+pub struct CaseTables {
+    embedded: &'static [Entry; 2048],
+    paper: &'static [Entry; 2048],
+}
+
+impl CaseTables {
+    /// Wraps generated arrays. Called by the code `include_tables!` emits.
+    #[doc(hidden)]
+    pub const fn from_static(
+        embedded: &'static [Entry; 2048],
+        paper: &'static [Entry; 2048],
+    ) -> Self {
+        CaseTables { embedded, paper }
+    }
+
+    /// The table a mode reads.
+    #[inline]
+    pub fn for_mode(&self, mode: crate::Mode) -> &'static [Entry; 2048] {
+        match mode {
+            crate::Mode::Paper => self.paper,
+            crate::Mode::Embedded | crate::Mode::Steps123 => self.embedded,
+        }
+    }
+}
+
+/// The committed tables.
+pub static DEFAULT: CaseTables = sc_macros::include_tables!("../tables/skeleton-climbing.ron");
+
+/// The grey edge of class `p` along `axis` (SPEC §2), as a cube-local edge id.
+#[inline]
+pub const fn grey_edge(p: u8, axis: usize) -> u8 {
+    let (a, b, c) = (p & 1, (p >> 1) & 1, (p >> 2) & 1);
+    match axis {
+        0 => (1 - b) + 2 * (1 - c),
+        1 => 4 + (1 - a) + 2 * c,
+        _ => 8 + a + 2 * b,
+    }
+}

@@ -1,0 +1,64 @@
+use crate::sweep::{Slices, Sweep};
+use crate::{Error, Params, Scalar, Scratch, Sink, Stats, Volume};
+
+/// An in-memory volume seen slice by slice.
+pub(crate) struct InMemory<'a, T> {
+    pub data: &'a [T],
+    pub nxy: usize,
+}
+
+impl<T> Slices<T> for InMemory<'_, T> {
+    #[inline]
+    fn slice(&self, z: usize) -> &[T] {
+        &self.data[z * self.nxy..(z + 1) * self.nxy]
+    }
+}
+
+/// Whether the grid has any cube: dims below 2 on an axis give an empty mesh.
+pub(crate) fn has_cubes(dims: [usize; 3]) -> bool {
+    dims.iter().all(|&d| d >= 2)
+}
+
+/// Extracts the surface without allocating: the caller lends [`Scratch`] and receives the mesh
+/// through `sink`. This is the whole algorithm; the other entry points wrap it.
+///
+/// ```
+/// use sc_runtime::{Params, Scratch, Sink, Volume, extract_into};
+///
+/// struct Count(usize, usize);
+/// impl Sink for Count {
+///     fn vertex(&mut self, _: [f32; 3], _: Option<[f32; 3]>) { self.0 += 1 }
+///     fn triangle(&mut self, _: [u32; 3]) { self.1 += 1 }
+/// }
+/// // One filled sample in a 3×3×3 grid: an octahedron around it, flattened by Step 4.
+/// let mut data = [0u8; 27];
+/// data[13] = 1;
+/// let len = Scratch::len([3, 3, 3]).unwrap();
+/// let (mut bytes, mut words) = ([0u8; 64], [0u32; 64]);
+/// assert!(len.bytes <= 64 && len.words <= 64);
+/// let scratch = Scratch::new(&mut bytes, &mut words, [3, 3, 3]).unwrap();
+/// let mut sink = Count(0, 0);
+/// let stats = extract_into(&Volume::new(&data, [3, 3, 3]).unwrap(), &Params::new(1.0), scratch, &mut sink).unwrap();
+/// assert_eq!((stats.t13, sink.1 as u64), (8, stats.triangles));
+/// ```
+pub fn extract_into<T: Scalar>(
+    volume: &Volume<'_, T>,
+    params: &Params,
+    scratch: Scratch<'_>,
+    sink: &mut impl Sink,
+) -> Result<Stats, Error> {
+    let dims = volume.dims();
+    if !has_cubes(dims) {
+        return Ok(Stats::default());
+    }
+    let src = InMemory {
+        data: volume.data(),
+        nxy: dims[0] * dims[1],
+    };
+    let mut sweep = Sweep::<T>::new(dims, params, scratch);
+    sweep.start(0, &src, sink, true)?;
+    for k in 0..dims[2] - 1 {
+        sweep.layer(k, &src, sink)?;
+    }
+    Ok(sweep.stats)
+}

@@ -1,0 +1,9 @@
+/// Receives the mesh as it is built: vertex `i` is the `i`-th call to [`Sink::vertex`] (for the
+/// sweep that produced it), and every triangle refers only to vertices already sent. A sink can
+/// therefore write a mesh out while the volume is still being read.
+pub trait Sink {
+    /// A new vertex in world units, with its unit normal when normals were asked for.
+    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>);
+    /// A triangle, wound so that `(b − a) × (c − a)` points from filled to empty.
+    fn triangle(&mut self, triangle: [u32; 3]);
+}

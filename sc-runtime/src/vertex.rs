@@ -1,0 +1,70 @@
+//! Step 1's vertex placement and the optional normals (SPEC §1, §7).
+
+use crate::Scalar;
+
+/// The SPEC §1 clamp: keeps vertices off grid points, so no triangle collapses when a sample
+/// equals the iso value exactly.
+const T_MIN: f64 = 1.0 / 1024.0;
+
+/// Where along an edge from sample `a` to sample `b` the surface crosses.
+#[inline]
+pub(crate) fn crossing(a: f64, b: f64, iso: f64) -> f64 {
+    let t = (iso - a) / (b - a);
+    if t.is_finite() {
+        t.clamp(T_MIN, 1.0 - T_MIN)
+    } else {
+        0.5
+    }
+}
+
+/// Reads samples and gradients around grid points of the slices a sweep step can see.
+pub(crate) struct Field<'v, T> {
+    pub dims: [usize; 3],
+    pub spacing: [f64; 3],
+    /// Slices `z - 1`, `z`, `z + 1` as available, by `z`.
+    pub slices: [Option<&'v [T]>; 4],
+    pub first: usize,
+}
+
+impl<T: Scalar> Field<'_, T> {
+    #[inline]
+    fn slice(&self, z: usize) -> &[T] {
+        self.slices[z - self.first].expect("the sweep keeps the slices it reads")
+    }
+
+    #[inline]
+    pub fn value(&self, x: usize, y: usize, z: usize) -> f64 {
+        self.slice(z)[x + self.dims[0] * y].to_f64()
+    }
+
+    /// Central differences inside, one-sided at the border, divided by spacing.
+    pub fn gradient(&self, p: [usize; 3]) -> [f64; 3] {
+        core::array::from_fn(|d| {
+            let n = self.dims[d];
+            let at = |c: usize| {
+                let mut q = p;
+                q[d] = c;
+                self.value(q[0], q[1], q[2])
+            };
+            let (lo, hi) = (p[d].saturating_sub(1), (p[d] + 1).min(n - 1));
+            (at(hi) - at(lo)) / ((hi - lo) as f64 * self.spacing[d])
+        })
+    }
+
+    /// The outward unit normal at `t` along the edge from `p` along `axis`: the negated,
+    /// interpolated gradient, or the edge direction where the gradient vanishes or is NaN.
+    pub fn normal(&self, p: [usize; 3], axis: usize, t: f64, a_filled: bool) -> [f32; 3] {
+        let mut q = p;
+        q[axis] += 1;
+        let (ga, gb) = (self.gradient(p), self.gradient(q));
+        let g: [f64; 3] = core::array::from_fn(|d| -(ga[d] + t * (gb[d] - ga[d])));
+        let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        if len > 0.0 && len.is_finite() {
+            g.map(|c| (c / len) as f32)
+        } else {
+            let mut n = [0.0; 3];
+            n[axis] = if a_filled { 1.0 } else { -1.0 };
+            n
+        }
+    }
+}
