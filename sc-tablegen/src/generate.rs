@@ -73,7 +73,19 @@ fn build_entry(nine: &[u8; 9], p: u8, case: u8) -> Result<Entry, String> {
                 });
             }
         }
-        return Err("no rotation of the class order is fold-free and embedded".into());
+        // SPEC §4's last resort: any greys-first order, the rest in lexicographic order.
+        let found = greys_first_orders(&class_order(nine, p, Rule::Base))
+            .map(|order| nibble(&loops, &order))
+            .find(|n| acceptable(n))
+            .ok_or("no greys-first order is fold-free and embedded")?;
+        let grey = grey_records(&loops, &found, p, &forced);
+        return Ok(Entry {
+            case,
+            triangles: found.triangles,
+            grey,
+            rule: Rule::Fallback,
+            paper: None,
+        });
     }
 
     let demoted = demoted_orders(nine, p, &forced)
@@ -124,6 +136,38 @@ fn demoted_orders<'a>(
             rest.try_into().expect("a reordering keeps all 12 edges")
         })
     })
+}
+
+/// Every order that keeps `base`'s first three edges first, the other nine permuted in
+/// lexicographic order of their positions in `base`.
+fn greys_first_orders(base: &[u8; 12]) -> impl Iterator<Item = [u8; 12]> + '_ {
+    let mut perm: [usize; 9] = core::array::from_fn(|i| i);
+    let mut done = false;
+    core::iter::from_fn(move || {
+        if done {
+            return None;
+        }
+        let mut order = *base;
+        for (i, &k) in perm.iter().enumerate() {
+            order[3 + i] = base[3 + k];
+        }
+        done = !next_permutation(&mut perm);
+        Some(order)
+    })
+}
+
+/// Advances to the next permutation in lexicographic order; false after the last.
+fn next_permutation(a: &mut [usize]) -> bool {
+    let Some(i) = (1..a.len()).rev().find(|&i| a[i - 1] < a[i]) else {
+        return false;
+    };
+    let j = (i..a.len())
+        .rev()
+        .find(|&j| a[j] > a[i - 1])
+        .expect("a[i] > a[i-1]");
+    a.swap(i - 1, j);
+    a[i..].reverse();
+    true
 }
 
 /// Whether a fold is the closing side of a forced grey's ear, the one fold paper mode keeps.

@@ -761,7 +761,10 @@ mod tests {
             assert_eq!(triangles_conflict(&fb, &fa), expected, "swapped");
         }
         for (s, counts) in seen.iter().enumerate().take(3) {
-            assert!(counts[0] > 50 && counts[1] > 50, "{s} shared: {counts:?}");
+            assert!(
+                counts[0] > 1000 && counts[1] > 1000,
+                "{s} shared: {counts:?}"
+            );
         }
         assert!(seen[3][1] > 0);
     }

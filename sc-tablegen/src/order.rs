@@ -21,7 +21,7 @@ pub fn full_order(nine: &[u8; 9]) -> [u8; 12] {
 /// The order used for `rule` in class `p`: class 0's order composed with ρ^k, then mirrored.
 pub fn class_order(nine: &[u8; 9], p: u8, rule: Rule) -> [u8; 12] {
     let turns = match rule {
-        Rule::Base | Rule::Demoted => 0,
+        Rule::Base | Rule::Demoted | Rule::Fallback => 0,
         Rule::Rot1 => 1,
         Rule::Rot2 => 2,
     };

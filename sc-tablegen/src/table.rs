@@ -72,6 +72,8 @@ pub enum Rule {
     Rot2,
     /// A forced fold: one grey moved out of the first three.
     Demoted,
+    /// No rotation worked: the first greys-first order that is fold-free and embedded.
+    Fallback,
 }
 
 impl Rule {
@@ -82,6 +84,7 @@ impl Rule {
             Rule::Rot1 => "rot1",
             Rule::Rot2 => "rot2",
             Rule::Demoted => "demoted",
+            Rule::Fallback => "fallback",
         }
     }
 }

@@ -160,7 +160,13 @@ fn drawing(case: u8) -> String {
 /// The summary printed by `dump --stats`.
 pub fn stats(set: &TableSet) -> String {
     let mut out = String::new();
-    let rules = [Rule::Base, Rule::Rot1, Rule::Rot2, Rule::Demoted];
+    let rules = [
+        Rule::Base,
+        Rule::Rot1,
+        Rule::Rot2,
+        Rule::Demoted,
+        Rule::Fallback,
+    ];
     let _ = writeln!(out, "order (class 0): greys 8 3 5, then {:?}", set.order);
     let _ = writeln!(out, "entries per rule:");
     for r in rules {
