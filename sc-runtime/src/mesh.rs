@@ -33,7 +33,6 @@ impl Sink for Mesh {
 pub(crate) struct OwnedScratch {
     bytes: Vec<u8>,
     words: Vec<u32>,
-    dims: [usize; 3],
 }
 
 impl OwnedScratch {
@@ -42,7 +41,6 @@ impl OwnedScratch {
         Ok(OwnedScratch {
             bytes: vec![0; len.bytes],
             words: vec![0; len.words],
-            dims,
         })
     }
 
@@ -51,7 +49,6 @@ impl OwnedScratch {
             bytes: &mut self.bytes,
             words: &mut self.words,
         }
-        .checked(self.dims)
     }
 }
 

@@ -51,14 +51,3 @@ impl<'a> Scratch<'a> {
         Ok(Scratch { bytes, words })
     }
 }
-
-impl Scratch<'_> {
-    /// Buffers sized by [`Scratch::len`] already; checked in debug builds.
-    pub(crate) fn checked(self, dims: [usize; 3]) -> Self {
-        debug_assert!(
-            Self::len(dims)
-                .is_ok_and(|l| self.bytes.len() >= l.bytes && self.words.len() >= l.words)
-        );
-        self
-    }
-}

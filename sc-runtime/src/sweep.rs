@@ -77,6 +77,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Number of vertex ids handed out, including those of a first plane not emitted.
+    #[cfg(feature = "std")]
     pub fn ids_used(&self) -> u32 {
         self.next_id
     }

@@ -58,7 +58,7 @@ impl<T: Scalar> Field<'_, T> {
         q[axis] += 1;
         let (ga, gb) = (self.gradient(p), self.gradient(q));
         let g: [f64; 3] = core::array::from_fn(|d| -(ga[d] + t * (gb[d] - ga[d])));
-        let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        let len = libm::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
         if len > 0.0 && len.is_finite() {
             g.map(|c| (c / len) as f32)
         } else {
