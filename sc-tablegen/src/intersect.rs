@@ -28,7 +28,7 @@ fn sign(v: f64) -> i8 {
     } else if v < 0.0 {
         -1
     } else {
-        // NaN lands here too; callers reject NaN input via `is_degenerate`.
+        // NaN lands here too; `projection` rejects non-finite input first.
         0
     }
 }
@@ -63,13 +63,20 @@ impl Proj {
 /// The projection in which `t` keeps non-zero area, or `None` if `t` has zero
 /// area. The three projected orientations are exactly the signs of the three
 /// components of the triangle's normal, so "all zero" is exact degeneracy.
+/// Non-finite coordinates also give `None`: the orientations would be NaN or
+/// meaningless, and no caller can do anything sound with such a triangle.
 fn projection(t: &[Point; 3]) -> Option<Proj> {
+    if !t.iter().flatten().all(|x| x.is_finite()) {
+        return None;
+    }
     [Proj(0, 1), Proj(1, 2), Proj(2, 0)]
         .into_iter()
         .find(|pr| pr.o2(&t[0], &t[1], &t[2]) != 0)
 }
 
 /// True if the triangle has zero area (its three points are collinear or coincide), exactly.
+///
+/// A triangle with a NaN or infinite coordinate counts as degenerate too.
 pub fn is_degenerate(t: &[Point; 3]) -> bool {
     projection(t).is_none()
 }
@@ -154,7 +161,7 @@ fn segments_meet(pr: Proj, a: &Point, b: &Point, c: &Point, d: &Point) -> bool {
 ///    lying on the same side of AB overlaps → conflict);
 ///  - 3 shared vertices: the same triangle twice → conflict.
 ///
-/// A degenerate (zero-area or NaN) input is reported as a conflict: it has no
+/// A degenerate (zero-area or non-finite) input is reported as a conflict: it has no
 /// well-defined "allowed contact", and a mesh containing one is defective
 /// anyway, so failing loudly is safer than guessing.
 pub fn triangles_conflict(a: &[Point; 3], b: &[Point; 3]) -> bool {
@@ -182,12 +189,7 @@ pub fn triangles_conflict(a: &[Point; 3], b: &[Point; 3]) -> bool {
         }
         2 => {
             let k = shared.iter().position(Option::is_none).unwrap();
-            let mut l = 3;
-            for m in 0..3 {
-                if !shared.contains(&Some(m)) {
-                    l = m;
-                }
-            }
+            let l = (0..3).find(|m| !shared.contains(&Some(*m))).unwrap();
             edge_conflict(&ta, k, b[l])
         }
         _ => true,
@@ -226,11 +228,23 @@ fn disjoint_conflict(ta: &Tri, tb: &Tri) -> bool {
 /// an opposite edge cannot be `A` (that edge misses `A` in a non-degenerate
 /// triangle). This also covers the "a direction lies in the other's cone"
 /// situations, e.g. coplanar fold-over or an edge lying along the other face.
+///
+/// If both free vertices of one triangle are strictly on one side of the
+/// other's plane, that triangle meets the plane only in `A`, so the answer
+/// is known before the second pair of orientations (the common case for
+/// neighbours on a smooth surface, which the mesh checker sees millions of).
 fn vertex_conflict(ta: &Tri, i: usize, tb: &Tri, j: usize) -> bool {
     let (b1, c1) = (&ta.v[(i + 1) % 3], &ta.v[(i + 2) % 3]);
+    let (s1, t1) = (tb.side(b1), tb.side(c1));
+    if s1 * t1 > 0 {
+        return false;
+    }
     let (b2, c2) = (&tb.v[(j + 1) % 3], &tb.v[(j + 2) % 3]);
-    tb.meets_segment(b1, c1, tb.side(b1), tb.side(c1))
-        || ta.meets_segment(b2, c2, ta.side(b2), ta.side(c2))
+    let (s2, t2) = (ta.side(b2), ta.side(c2));
+    if s2 * t2 > 0 {
+        return false;
+    }
+    tb.meets_segment(b1, c1, s1, t1) || ta.meets_segment(b2, c2, s2, t2)
 }
 
 /// Shared edge: `a[k]` is the vertex of `a` off the shared edge, `d` the one
@@ -282,6 +296,12 @@ mod tests {
         assert!(is_degenerate(&[O, [1.0, 1.0, 1.0], [2.0, 2.0, 2.0]]));
         assert!(is_degenerate(&[O, O, O]));
         assert!(is_degenerate(&[O, X, [f64::NAN, 0.0, 0.0]]));
+        assert!(is_degenerate(&[O, X, [0.0, 1.0, f64::NAN]]));
+        assert!(is_degenerate(&[O, X, [0.0, f64::INFINITY, 0.0]]));
+        assert!(triangles_conflict(
+            &[O, X, [0.0, 1.0, f64::NAN]],
+            &[Y, Z, [5.0; 3]]
+        ));
         // Nearly collinear: naive cross products round to zero here.
         let e = f64::EPSILON / 4.0;
         assert!(!is_degenerate(&[
