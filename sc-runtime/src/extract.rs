@@ -60,5 +60,5 @@ pub fn extract_into<T: Scalar>(
     for k in 0..dims[2] - 1 {
         sweep.layer(k, &src, sink)?;
     }
-    Ok(sweep.stats)
+    Ok(sweep.stats())
 }

@@ -69,7 +69,7 @@ pub fn extract_par<T: Scalar>(
                     sweep.layer(k, &src, &mut mesh)?;
                     progress(1);
                 }
-                mesh.stats = sweep.stats;
+                mesh.stats = sweep.stats();
                 Ok(Part { mesh, first_plane })
             })
             .collect()

@@ -16,15 +16,18 @@ pub trait Scalar: Copy + Send + Sync + 'static {
 macro_rules! int_scalar {
     ($($t:ty),*) => {$(
         impl Scalar for $t {
-            type Threshold = i64;
+            /// The smallest filled value, or `None` when no value of the type reaches `iso`.
+            /// Comparing in the sample's own width lets the classification loop vectorise.
+            type Threshold = Option<$t>;
             #[inline]
-            fn threshold(iso: f64) -> i64 {
+            fn threshold(iso: f64) -> Option<$t> {
                 // `v >= iso` is `v >= ceil(iso)` for integers; NaN fills nothing.
-                if iso.is_nan() { i64::MAX } else { libm_ceil(iso) }
+                let c = if iso.is_nan() { i64::MAX } else { libm_ceil(iso) };
+                if c > <$t>::MAX as i64 { None } else { Some(c.max(<$t>::MIN as i64) as $t) }
             }
             #[inline]
-            fn filled(self, t: i64) -> bool {
-                self as i64 >= t
+            fn filled(self, t: Option<$t>) -> bool {
+                t.is_some_and(|t| self >= t)
             }
             #[inline]
             fn to_f64(self) -> f64 {
@@ -35,26 +38,39 @@ macro_rules! int_scalar {
 }
 int_scalar!(u8, i8, u16, i16, u32, i32);
 
-macro_rules! float_scalar {
-    ($($t:ty),*) => {$(
-        impl Scalar for $t {
-            type Threshold = f64;
-            #[inline]
-            fn threshold(iso: f64) -> f64 {
-                iso
-            }
-            #[inline]
-            fn filled(self, t: f64) -> bool {
-                self as f64 >= t
-            }
-            #[inline]
-            fn to_f64(self) -> f64 {
-                self as f64
-            }
-        }
-    )*};
+impl Scalar for f32 {
+    /// The smallest `f32` at or above `iso`, so `v >= t` in `f32` is exactly `v as f64 >= iso`.
+    type Threshold = f32;
+    #[inline]
+    fn threshold(iso: f64) -> f32 {
+        let t = iso as f32;
+        if (t as f64) < iso { t.next_up() } else { t }
+    }
+    #[inline]
+    fn filled(self, t: f32) -> bool {
+        self >= t
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
 }
-float_scalar!(f32, f64);
+
+impl Scalar for f64 {
+    type Threshold = f64;
+    #[inline]
+    fn threshold(iso: f64) -> f64 {
+        iso
+    }
+    #[inline]
+    fn filled(self, t: f64) -> bool {
+        self >= t
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
 
 /// `ceil` saturated to `i64`, without `std`: the `as` cast truncates toward zero and saturates.
 fn libm_ceil(x: f64) -> i64 {

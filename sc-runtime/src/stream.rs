@@ -102,6 +102,6 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
             self.sweep
                 .layer(self.dims[2] - 2, &self.ring, &mut self.sink)?;
         }
-        Ok((self.sink, self.sweep.stats))
+        Ok((self.sink, self.sweep.stats()))
     }
 }

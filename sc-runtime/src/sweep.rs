@@ -6,8 +6,12 @@
 //! order, plane 0, z-edges of layer 0, plane 1, z-edges of layer 1, …, and within each group row by
 //! row, so a sweep that starts at any layer numbers the vertices the way a full sweep does, offset
 //! by a constant. That is what makes the parallel mesh identical to the sequential one.
+//!
+//! Like Flying Edges, every pass skips the parts of a row where nothing changes: a classified row
+//! records where its x-edges change, and a cube row only visits the span where its four sample
+//! rows can disagree.
 
-use crate::scratch::{BYTE_PLANES, SPAN_ROWS, Scratch, WORD_PLANES};
+use crate::scratch::{Scratch, WORD_PLANES};
 use crate::tables::{Entry, NO_EAR, grey_edge};
 use crate::vertex::{Field, crossing};
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
@@ -31,26 +35,36 @@ enum Decision {
     Blocked,
 }
 
-/// A row's classified samples are constant on `0..=lo` and on `hi..nx` (`lo = nx − 1`, `hi = 0` for
-/// a uniform row). For a case row, the non-trivial cubes lie in `lo..hi`.
-#[derive(Clone, Copy)]
-struct Span {
-    lo: usize,
-    hi: usize,
+/// What the vertex and triangle passes read: classified slices, cube cases and row spans. Kept
+/// apart from [`Out`] so a pass can read rows while it writes vertex ids.
+struct Grid<'s> {
+    dims: [usize; 3],
+    mode: Mode,
+    entries: &'static [Entry; 2048],
+    /// Four slices of 0/1 bytes, slice `z` at `z % 4`.
+    filled: &'s mut [u8],
+    /// Three layers of cube cases, layer `k` at `k % 3`, row stride `nx`.
+    cases: &'s mut [u8],
+    /// `(lo, hi)` pairs: per classified row, the x-edge changes lie in `lo..hi` (`lo = nx − 1`,
+    /// `hi = 0` for a uniform row); per cube row, the non-trivial cubes lie in `lo..hi`.
+    spans: &'s mut [u32],
+}
+
+/// Vertex numbering and counts.
+struct Out<'s> {
+    /// Two planes of x- then y-edge ids (plane `n` at `n % 2`), then one layer of z-edge ids.
+    ids: &'s mut [u32],
+    next_id: u32,
+    /// False while numbering a first plane that the previous parallel chunk emits.
+    emit: bool,
+    stats: Stats,
 }
 
 pub(crate) struct Sweep<'s, T: Scalar> {
-    dims: [usize; 3],
+    grid: Grid<'s>,
+    out: Out<'s>,
     params: Params,
     threshold: T::Threshold,
-    entries: &'static [Entry; 2048],
-    filled: &'s mut [u8],
-    cases: &'s mut [u8],
-    ids: &'s mut [u32],
-    spans: &'s mut [u32],
-    next_id: u32,
-    emit: bool,
-    pub stats: Stats,
 }
 
 impl<'s, T: Scalar> Sweep<'s, T> {
@@ -58,28 +72,34 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let nxy = dims[0] * dims[1];
         let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy);
         let (ids, spans) = scratch.words.split_at_mut(WORD_PLANES * nxy);
-        debug_assert!(
-            rest.len() >= (BYTE_PLANES - 4) * nxy && spans.len() >= 2 * SPAN_ROWS * dims[1]
-        );
         Sweep {
-            dims,
+            grid: Grid {
+                dims,
+                mode: params.mode,
+                entries: params.tables.for_mode(params.mode),
+                filled,
+                cases: &mut rest[..3 * nxy],
+                spans,
+            },
+            out: Out {
+                ids,
+                next_id: 0,
+                emit: true,
+                stats: Stats::default(),
+            },
             params: *params,
             threshold: T::threshold(params.iso),
-            entries: params.tables.for_mode(params.mode),
-            filled,
-            cases: &mut rest[..3 * nxy],
-            ids,
-            spans,
-            next_id: 0,
-            emit: true,
-            stats: Stats::default(),
         }
+    }
+
+    pub fn stats(&self) -> Stats {
+        self.out.stats
     }
 
     /// Number of vertex ids handed out, including those of a first plane not emitted.
     #[cfg(feature = "std")]
     pub fn ids_used(&self) -> u32 {
-        self.next_id
+        self.out.next_id
     }
 
     /// Prepares layer `z0`: classifies slices `z0 − 1 ..= z0 + 1`, computes cases of layers
@@ -93,15 +113,15 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         emit_plane: bool,
     ) -> Result<(), Error> {
         for z in z0.saturating_sub(1)..=z0 + 1 {
-            self.classify(z, src.slice(z));
+            self.grid.classify::<T>(z, src.slice(z), self.threshold);
         }
         if z0 >= 1 {
-            self.compute_cases(z0 - 1);
+            self.grid.compute_cases(z0 - 1);
         }
-        self.compute_cases(z0);
-        self.emit = emit_plane;
+        self.grid.compute_cases(z0);
+        self.out.emit = emit_plane;
         let r = self.plane_vertices(z0, src, sink);
-        self.emit = true;
+        self.out.emit = true;
         r
     }
 
@@ -112,10 +132,10 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         src: &impl Slices<T>,
         sink: &mut impl Sink,
     ) -> Result<(), Error> {
-        let nz = self.dims[2];
-        if k + 2 < nz {
-            self.classify(k + 2, src.slice(k + 2));
-            self.compute_cases(k + 1);
+        if k + 2 < self.grid.dims[2] {
+            self.grid
+                .classify::<T>(k + 2, src.slice(k + 2), self.threshold);
+            self.grid.compute_cases(k + 1);
         }
         self.z_vertices(k, src, sink)?;
         self.plane_vertices(k + 1, src, sink)?;
@@ -123,85 +143,290 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         Ok(())
     }
 
-    // ---- Step 1: classification and row spans -------------------------------------------------
-
-    fn classify(&mut self, z: usize, slice: &[T]) {
-        let [nx, ny, _] = self.dims;
-        let slot = z % 4;
-        let out = &mut self.filled[slot * nx * ny..(slot + 1) * nx * ny];
-        for (o, v) in out.iter_mut().zip(slice) {
-            *o = u8::from(v.filled(self.threshold));
+    fn field<'v>(&self, src: &'v impl Slices<T>, z_lo: usize, z_hi: usize) -> Field<'v, T> {
+        let nz = self.grid.dims[2];
+        let first = z_lo.saturating_sub(1);
+        let mut slices = [None; 4];
+        for (i, z) in (first..=(z_hi + 1).min(nz - 1)).enumerate() {
+            slices[i] = Some(src.slice(z));
         }
+        Field {
+            dims: self.grid.dims,
+            spacing: self.params.spacing,
+            slices,
+            first,
+        }
+    }
+
+    /// Vertices on the x- and y-edges of plane `n`, row by row.
+    fn plane_vertices(
+        &mut self,
+        n: usize,
+        src: &impl Slices<T>,
+        sink: &mut impl Sink,
+    ) -> Result<(), Error> {
+        let [nx, ny, _] = self.grid.dims;
+        let field = self.field(src, n, n);
+        let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
+        let xbase = (n % 2) * 2 * nx * ny;
+        let ybase = xbase + nx * ny;
         for y in 0..ny {
-            let row = &self.filled[slot * nx * ny + y * nx..][..nx];
-            let lo = row.windows(2).position(|w| w[0] != w[1]).unwrap_or(nx - 1);
-            let hi = row
-                .windows(2)
-                .rposition(|w| w[0] != w[1])
-                .map_or(0, |i| i + 1);
-            self.set_span(slot * ny + y, Span { lo, hi });
+            let row = grid.row(n, y);
+            let (lo, hi) = grid.span(grid.slice_row(n, y));
+            let x_grey = y % 2 == 1 && n % 2 == 1;
+            for x in lo..hi {
+                if row[x] != row[x + 1] {
+                    let id = out.edge_vertex(grid, params, [x, y, n], 0, x_grey, &field, sink)?;
+                    out.ids[xbase + y * nx + x] = id;
+                }
+            }
+            if y + 1 < ny {
+                let next = grid.row(n, y + 1);
+                let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
+                for x in start..end {
+                    if row[x] != next[x] {
+                        let grey = x % 2 == 1 && n % 2 == 0;
+                        let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
+                        out.ids[ybase + y * nx + x] = id;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Vertices on the z-edges of layer `k`, row by row.
+    fn z_vertices(
+        &mut self,
+        k: usize,
+        src: &impl Slices<T>,
+        sink: &mut impl Sink,
+    ) -> Result<(), Error> {
+        let [nx, ny, _] = self.grid.dims;
+        let field = self.field(src, k, k + 1);
+        let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
+        let zbase = 4 * nx * ny;
+        for y in 0..ny {
+            let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
+            let (start, end) = grid.union_span(&[(y, k), (y, k + 1)]);
+            for x in start..end {
+                if below[x] != above[x] {
+                    let grey = x % 2 == 0 && y % 2 == 0;
+                    let id = out.edge_vertex(grid, params, [x, y, k], 2, grey, &field, sink)?;
+                    out.ids[zbase + y * nx + x] = id;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Steps 3 and 4: each cube's table triangles, with the ears of merged grey edges replaced.
+    fn triangles(&mut self, k: usize, sink: &mut impl Sink) {
+        let [nx, ny, _] = self.grid.dims;
+        let nxy = nx * ny;
+        let (lo, hi) = (k % 2, (k + 1) % 2);
+        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`.
+        let edge_at: [usize; 12] = core::array::from_fn(|e| {
+            let r = e % 4;
+            let (a, b) = (r & 1, r >> 1);
+            match e / 4 {
+                0 => [lo, hi][b] * 2 * nxy + a * nx,
+                1 => [lo, hi][b] * 2 * nxy + nxy + a,
+                _ => 4 * nxy + a + b * nx,
+            }
+        });
+        let grid = &self.grid;
+        let ids = &*self.out.ids;
+        let stats = &mut self.out.stats;
+        let merging = grid.mode != Mode::Steps123;
+        let entries = grid.entries;
+        for j in 0..ny - 1 {
+            let (start, end) = grid.span(grid.case_row(k, j));
+            let cases = &grid.cases[(k % 3) * nxy + j * nx..][..nx];
+            let class_jk = (j & 1) << 1 | (k & 1) << 2;
+            for (i, &case) in cases.iter().enumerate().take(end).skip(start) {
+                if case == 0 || case == 255 {
+                    continue;
+                }
+                let class = (i & 1) | class_jk;
+                let entry = &entries[class * 256 + usize::from(case)];
+                stats.t13 += u64::from(entry.count);
+                let at = i + nx * j;
+                let id = |e: u8| ids[edge_at[usize::from(e)] + at];
+                // Per triangle: emit as is, skip (a merged ear), or emit the merged pair's
+                // triangle instead (the ear of the pair's owner).
+                let mut replace: [Option<Option<[u32; 3]>>; 5] = [None; 5];
+                if merging {
+                    for axis in 0..3 {
+                        let ear = entry.ears[axis];
+                        if ear != NO_EAR && id(grey_edge(class as u8, axis)) == MERGED {
+                            replace[usize::from(ear)] =
+                                Some(grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at));
+                        }
+                    }
+                }
+                for (t, r) in entry.tris[..usize::from(entry.count)].iter().zip(replace) {
+                    if let Some(tri) = r.unwrap_or_else(|| Some(t.map(id))) {
+                        stats.triangles += 1;
+                        sink.triangle(tri);
+                    }
+                }
+            }
         }
     }
+}
 
-    fn span(&self, row: usize) -> Span {
-        Span {
-            lo: self.spans[2 * row] as usize,
-            hi: self.spans[2 * row + 1] as usize,
+impl Out<'_> {
+    /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn edge_vertex<T: Scalar>(
+        &mut self,
+        grid: &Grid<'_>,
+        params: &Params,
+        p: [usize; 3],
+        axis: usize,
+        grey: bool,
+        field: &Field<'_, T>,
+        sink: &mut impl Sink,
+    ) -> Result<u32, Error> {
+        let decision = if grey {
+            grid.decide(p, axis)
+        } else {
+            Decision::Keep
+        };
+        if self.emit {
+            self.stats.v13 += 1;
+            self.stats.merged += u64::from(decision == Decision::Merge);
+            self.stats.blocked += u64::from(decision == Decision::Blocked);
         }
+        if decision == Decision::Merge {
+            return Ok(MERGED);
+        }
+        let id = self.next_id;
+        if id == MERGED {
+            return Err(Error::TooManyVertices);
+        }
+        self.next_id += 1;
+        if self.emit {
+            self.stats.vertices += 1;
+            let mut q = p;
+            q[axis] += 1;
+            let (a, b) = (field.value(p), field.value(q));
+            let t = if a.is_nan() || b.is_nan() {
+                0.5
+            } else {
+                crossing(a, b, params.iso)
+            };
+            let pos: [f32; 3] = core::array::from_fn(|d| {
+                let c = p[d] as f64 + if d == axis { t } else { 0.0 };
+                (params.origin[d] + c * params.spacing[d]) as f32
+            });
+            let normal = params
+                .normals
+                .then(|| field.normal(p, axis, t, grid.is_filled(p)));
+            sink.vertex(pos, normal);
+        }
+        Ok(id)
     }
+}
 
-    fn set_span(&mut self, row: usize, s: Span) {
-        self.spans[2 * row] = s.lo as u32;
-        self.spans[2 * row + 1] = s.hi as u32;
-    }
-
-    fn filled_row(&self, z: usize, y: usize) -> &[u8] {
+impl Grid<'_> {
+    fn row(&self, z: usize, y: usize) -> &[u8] {
         let [nx, ny, _] = self.dims;
-        let start = (z % 4) * nx * ny + y * nx;
-        &self.filled[start..start + nx]
+        &self.filled[(z % 4) * nx * ny + y * nx..][..nx]
     }
 
-    /// The points where some of the rows `(y, z)` differ from one another or vary along x, as an
-    /// inclusive range `start..=end` (empty when `start > end`).
+    fn is_filled(&self, p: [usize; 3]) -> bool {
+        self.row(p[2], p[1])[p[0]] == 1
+    }
+
+    fn slice_row(&self, z: usize, y: usize) -> usize {
+        (z % 4) * self.dims[1] + y
+    }
+
+    fn case_row(&self, k: usize, j: usize) -> usize {
+        4 * self.dims[1] + (k % 3) * self.dims[1] + j
+    }
+
+    fn span(&self, row: usize) -> (usize, usize) {
+        (
+            self.spans[2 * row] as usize,
+            self.spans[2 * row + 1] as usize,
+        )
+    }
+
+    fn set_span(&mut self, row: usize, (lo, hi): (usize, usize)) {
+        self.spans[2 * row] = lo as u32;
+        self.spans[2 * row + 1] = hi as u32;
+    }
+
+    /// Step 1's classification of slice `z`, and each row's span of x-edge changes.
+    fn classify<T: Scalar>(&mut self, z: usize, slice: &[T], threshold: T::Threshold) {
+        let [nx, ny, _] = self.dims;
+        let slot = (z % 4) * nx * ny;
+        for y in 0..ny {
+            let row = &mut self.filled[slot + y * nx..][..nx];
+            for (o, v) in row.iter_mut().zip(&slice[y * nx..][..nx]) {
+                *o = u8::from(v.filled(threshold));
+            }
+            let span = match first_differing(row, row[0]) {
+                None => (nx - 1, 0),
+                Some(first) => (
+                    first - 1,
+                    last_differing(row, row[nx - 1]).map_or(0, |l| l + 1),
+                ),
+            };
+            self.set_span(self.slice_row(z, y), span);
+        }
+    }
+
+    /// The x range `start..end` outside which the rows `(y, z)` agree with each other and are
+    /// constant along x.
     fn union_span(&self, rows: &[(usize, usize)]) -> (usize, usize) {
         let nx = self.dims[0];
-        let ny = self.dims[1];
-        let first = self.filled_row(rows[0].1, rows[0].0);
+        let first = self.row(rows[0].1, rows[0].0);
         let (f0, f1) = (first[0], first[nx - 1]);
         let (mut lo, mut hi) = (nx - 1, 0);
         let (mut same0, mut same1) = (true, true);
         for &(y, z) in rows {
-            let s = self.span((z % 4) * ny + y);
-            lo = lo.min(s.lo);
-            hi = hi.max(s.hi);
-            let r = self.filled_row(z, y);
+            let (l, h) = self.span(self.slice_row(z, y));
+            lo = lo.min(l);
+            hi = hi.max(h);
+            let r = self.row(z, y);
             same0 &= r[0] == f0;
             same1 &= r[nx - 1] == f1;
         }
-        (if same0 { lo } else { 0 }, if same1 { hi } else { nx - 1 })
+        let start = if same0 { lo } else { 0 };
+        let end = if same1 { hi + 1 } else { nx };
+        (start, end.max(start))
     }
 
+    /// Cube cases of layer `k`, over each cube row's span of non-trivial cubes.
     fn compute_cases(&mut self, k: usize) {
         let [nx, ny, _] = self.dims;
-        let slot = k % 3;
         for j in 0..ny - 1 {
-            let (start, end) = self.union_span(&[(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)]);
-            // Cubes `start..end` can be non-trivial: cube `end` lies wholly in the constant tail.
-            let (lo, hi) = (start, end.min(nx - 1));
-            self.set_span(4 * ny + slot * ny + j, Span { lo, hi: hi.max(lo) });
+            let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)];
+            // Points `start..end` may vary, so cubes `start..end - 1` may be non-trivial.
+            let (start, end) = self.union_span(&rows);
+            let span = (start, (end.max(1) - 1).max(start));
+            self.set_span(self.case_row(k, j), span);
+            let (lo, hi) = span;
             if lo >= hi {
                 continue;
             }
-            let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)]
-                .map(|(y, z)| (z % 4) * nx * ny + y * nx);
-            let out_start = slot * nx * ny + j * nx;
-            let (filled, cases) = (&*self.filled, &mut *self.cases);
-            for i in lo..hi {
-                let mut case = 0u8;
-                for (r, &row) in rows.iter().enumerate() {
-                    case |= filled[row + i] << (2 * r) | filled[row + i + 1] << (2 * r + 1);
-                }
-                cases[out_start + i] = case;
+            let [r0, r1, r2, r3] =
+                rows.map(|(y, z)| &self.filled[(z % 4) * nx * ny + y * nx..][lo..=hi]);
+            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..hi - lo];
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = r0[i]
+                    | r0[i + 1] << 1
+                    | r1[i] << 2
+                    | r1[i + 1] << 3
+                    | r2[i] << 4
+                    | r2[i + 1] << 5
+                    | r3[i] << 6
+                    | r3[i + 1] << 7;
             }
         }
     }
@@ -211,15 +436,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         self.cases[(k % 3) * nx * ny + j * nx + i]
     }
 
-    fn is_filled(&self, x: usize, y: usize, z: usize) -> bool {
-        self.filled_row(z, y)[x] == 1
-    }
-
-    // ---- Step 4's decision: which occupied grey edges merge -----------------------------------
-
     /// Step 4's decision for the occupied grey edge from `p` along `axis` (SPEC §5).
     fn decide(&self, p: [usize; 3], axis: usize) -> Decision {
-        if self.params.mode == Mode::Steps123 {
+        if self.mode == Mode::Steps123 {
             return Decision::Keep;
         }
         let [l, m, n] = p;
@@ -237,13 +456,13 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             }
             _ => return Decision::Keep,
         };
-        if self.params.mode == Mode::Paper {
+        if self.mode == Mode::Paper {
             return Decision::Merge;
         }
-        let entries = self.entries;
         let mergeable = cubes.iter().all(|&(i, j, k)| {
             let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
-            entries[class * 256 + usize::from(self.case_at(i, j, k))].mergeable >> axis & 1 == 1
+            self.entries[class * 256 + usize::from(self.case_at(i, j, k))].mergeable >> axis & 1
+                == 1
         });
         if mergeable && !self.pinch(p, axis) {
             Decision::Merge
@@ -252,29 +471,28 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         }
     }
 
-    /// SPEC §5 (b): the lower end `p` is cut off in every face of the relevant fan around it.
+    /// SPEC §5 (b): the lower end `p` is cut off in every face of its fan: all four faces of the
+    /// horizontal plane for x- and y-greys, all eight vertical faces for z-greys. A corner is cut
+    /// off when both its face neighbours differ from it and it or the diagonal corner is filled;
+    /// a missing face (grid border) is not cut off.
     fn pinch(&self, p: [usize; 3], axis: usize) -> bool {
-        let [nx, ny, nz] = self.dims;
-        let [l, m, n] = p;
-        let f = |x: usize, y: usize, z: usize| self.is_filled(x, y, z);
-        let centre = f(l, m, n);
-        // The two in-plane directions of the faces to test, and for z-greys the vertical one.
-        let dirs: &[[usize; 2]] = if axis == 2 {
+        let centre = self.is_filled(p);
+        // Face planes as pairs of axes spanning them.
+        let planes: &[[usize; 2]] = if axis == 2 {
             &[[0, 2], [1, 2]]
         } else {
             &[[0, 1]]
         };
-        let lim = [nx, ny, nz];
-        for &[u, v] in dirs {
-            // Both neighbours along u and v must exist, and differ from the centre.
+        let at = |q: [usize; 3]| self.is_filled(q);
+        for &[u, v] in planes {
             for d in [u, v] {
-                if p[d] == 0 || p[d] + 1 >= lim[d] {
+                if p[d] == 0 || p[d] + 1 >= self.dims[d] {
                     return false;
                 }
                 for s in [p[d] - 1, p[d] + 1] {
                     let mut q = p;
                     q[d] = s;
-                    if f(q[0], q[1], q[2]) == centre {
+                    if at(q) == centre {
                         return false;
                     }
                 }
@@ -285,7 +503,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                         let mut q = p;
                         q[u] = su;
                         q[v] = sv;
-                        if !f(q[0], q[1], q[2]) {
+                        if !at(q) {
                             return false;
                         }
                     }
@@ -295,216 +513,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         true
     }
 
-    // ---- Step 1: vertices ---------------------------------------------------------------------
-
-    fn new_vertex(
-        &mut self,
-        p: [usize; 3],
-        axis: usize,
-        field: &Field<'_, T>,
-        sink: &mut impl Sink,
-    ) -> Result<u32, Error> {
-        let id = self.next_id;
-        if id == MERGED {
-            return Err(Error::TooManyVertices);
-        }
-        self.next_id += 1;
-        if self.emit {
-            self.stats.vertices += 1;
-            let mut q = p;
-            q[axis] += 1;
-            let (a, b) = (field.value(p[0], p[1], p[2]), field.value(q[0], q[1], q[2]));
-            let t = if a.is_nan() || b.is_nan() {
-                0.5
-            } else {
-                crossing(a, b, self.params.iso)
-            };
-            let pos: [f32; 3] = core::array::from_fn(|d| {
-                let c = p[d] as f64 + if d == axis { t } else { 0.0 };
-                (self.params.origin[d] + c * self.params.spacing[d]) as f32
-            });
-            let a_filled = self.is_filled(p[0], p[1], p[2]);
-            let normal = self
-                .params
-                .normals
-                .then(|| field.normal(p, axis, t, a_filled));
-            sink.vertex(pos, normal);
-        }
-        Ok(id)
-    }
-
-    fn field<'v>(
-        &self,
-        src: &'v impl Slices<T>,
-        zs: core::ops::RangeInclusive<usize>,
-    ) -> Field<'v, T> {
-        let nz = self.dims[2];
-        let first = zs.start().saturating_sub(1);
-        let mut slices = [None; 4];
-        for (i, z) in (first..=(zs.end() + 1).min(nz - 1)).enumerate() {
-            slices[i] = Some(src.slice(z));
-        }
-        Field {
-            dims: self.dims,
-            spacing: self.params.spacing,
-            slices,
-            first,
-        }
-    }
-
-    /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number.
-    fn edge_vertex(
-        &mut self,
-        p: [usize; 3],
-        axis: usize,
-        grey: bool,
-        field: &Field<'_, T>,
-        sink: &mut impl Sink,
-    ) -> Result<u32, Error> {
-        let decision = if grey {
-            self.decide(p, axis)
-        } else {
-            Decision::Keep
-        };
-        if self.emit {
-            self.stats.v13 += 1;
-            self.stats.merged += u64::from(decision == Decision::Merge);
-            self.stats.blocked += u64::from(decision == Decision::Blocked);
-        }
-        if decision == Decision::Merge {
-            return Ok(MERGED);
-        }
-        self.new_vertex(p, axis, field, sink)
-    }
-
-    /// Vertices on the x- and y-edges of plane `n`, row by row.
-    fn plane_vertices(
-        &mut self,
-        n: usize,
-        src: &impl Slices<T>,
-        sink: &mut impl Sink,
-    ) -> Result<(), Error> {
-        let [nx, ny, _] = self.dims;
-        let field = self.field(src, n..=n);
-        let (xbase, ybase) = ((n % 2) * 2 * nx * ny, (n % 2) * 2 * nx * ny + nx * ny);
-        for y in 0..ny {
-            let s = self.span((n % 4) * ny + y);
-            let x_grey = y % 2 == 1 && n % 2 == 1;
-            for x in s.lo..s.hi {
-                let row = self.filled_row(n, y);
-                if row[x] != row[x + 1] {
-                    let id = self.edge_vertex([x, y, n], 0, x_grey, &field, sink)?;
-                    self.ids[xbase + y * nx + x] = id;
-                }
-            }
-            if y + 1 < ny {
-                let (start, end) = self.union_span(&[(y, n), (y + 1, n)]);
-                for x in start..=end.min(nx - 1) {
-                    if self.is_filled(x, y, n) != self.is_filled(x, y + 1, n) {
-                        let grey = x % 2 == 1 && n % 2 == 0;
-                        let id = self.edge_vertex([x, y, n], 1, grey, &field, sink)?;
-                        self.ids[ybase + y * nx + x] = id;
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// Vertices on the z-edges of layer `k`, row by row.
-    fn z_vertices(
-        &mut self,
-        k: usize,
-        src: &impl Slices<T>,
-        sink: &mut impl Sink,
-    ) -> Result<(), Error> {
-        let [nx, ny, _] = self.dims;
-        let field = self.field(src, k..=k + 1);
-        let zbase = 4 * nx * ny;
-        for y in 0..ny {
-            let (start, end) = self.union_span(&[(y, k), (y, k + 1)]);
-            for x in start..=end.min(nx - 1) {
-                if self.is_filled(x, y, k) != self.is_filled(x, y, k + 1) {
-                    let grey = x % 2 == 0 && y % 2 == 0;
-                    let id = self.edge_vertex([x, y, k], 2, grey, &field, sink)?;
-                    self.ids[zbase + y * nx + x] = id;
-                }
-            }
-        }
-        Ok(())
-    }
-
-    // ---- Steps 3 and 4: triangles -------------------------------------------------------------
-
-    fn triangles(&mut self, k: usize, sink: &mut impl Sink) {
-        let [nx, ny, _] = self.dims;
-        let nxy = nx * ny;
-        let (lo, hi) = (k % 2, (k + 1) % 2);
-        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`.
-        let edge_at: [usize; 12] = core::array::from_fn(|e| {
-            let r = e % 4;
-            let (a, b) = (r & 1, r >> 1);
-            match e / 4 {
-                0 => [lo, hi][b] * 2 * nxy + a * nx,
-                1 => [lo, hi][b] * 2 * nxy + nxy + a,
-                _ => 4 * nxy + a + b * nx,
-            }
-        });
-        let merging = self.params.mode != Mode::Steps123;
-        for j in 0..ny - 1 {
-            let s = self.span(4 * ny + (k % 3) * ny + j);
-            for i in s.lo..s.hi {
-                let case = self.case_at(i, j, k);
-                if case == 0 || case == 255 {
-                    continue;
-                }
-                let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
-                let entries = self.entries;
-                let entry = &entries[class * 256 + usize::from(case)];
-                self.stats.t13 += u64::from(entry.count);
-                let at = i + nx * j;
-                let id = |e: u8| self.ids[edge_at[usize::from(e)] + at];
-                // Per triangle: emit as is, skip (a merged ear), or replace by the merged pair's
-                // triangle (the ear of the pair's owner).
-                let mut replace: [Option<Option<[u32; 3]>>; 5] = [None; 5];
-                if merging {
-                    for axis in 0..3 {
-                        let ear = entry.ears[axis];
-                        if ear == NO_EAR || id(grey_edge(class as u8, axis)) != MERGED {
-                            continue;
-                        }
-                        replace[usize::from(ear)] =
-                            Some(self.merged_triangle(i, j, k, axis, entry, &edge_at));
-                    }
-                }
-                for (t, r) in entry.tris[..usize::from(entry.count)].iter().zip(replace) {
-                    let tri = match r {
-                        None => Some(t.map(id)),
-                        Some(merged) => merged,
-                    };
-                    if let Some(tri) = tri {
-                        self.stats.triangles += 1;
-                        sink.triangle(tri);
-                    }
-                }
-            }
-        }
-    }
-
     /// For a merged grey edge: the triangle that replaces this cube's ear and its partner's, if
     /// this cube is the pair's owner (the partner then emits nothing for its ear).
     fn merged_triangle(
         &self,
-        i: usize,
-        j: usize,
-        k: usize,
+        ids: &[u32],
+        [i, j, k]: [usize; 3],
         axis: usize,
         entry: &Entry,
         edge_at: &[usize; 12],
     ) -> Option<[u32; 3]> {
         let (a, b) = (i & 1, j & 1);
-        // x-greys pair with the y-neighbour; y-greys with the x-neighbour; z-greys alternate by
-        // layer so the quads above and below a sample choose different diagonals.
+        // x-greys pair with the y-neighbour and y-greys with the x-neighbour, so the diagonal is
+        // horizontal; z-greys alternate by layer so the quads above and below a sample choose
+        // different diagonals.
         let along_y = match axis {
             0 => true,
             1 => false,
@@ -524,7 +546,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let pclass = (pi & 1) | (pj & 1) << 1 | (k & 1) << 2;
         let pentry = &self.entries[pclass * 256 + usize::from(self.case_at(pi, pj, k))];
         let ear = |e: &Entry, at: usize| {
-            e.tris[usize::from(e.ears[axis])].map(|x| self.ids[edge_at[usize::from(x)] + at])
+            e.tris[usize::from(e.ears[axis])].map(|x| ids[edge_at[usize::from(x)] + at])
         };
         let [ba, _, fa] = ear(entry, i + nx * j);
         let [bb, _, fb] = ear(pentry, pi + nx * pj);
@@ -534,4 +556,31 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         );
         Some(if ba == fb { [fa, ba, bb] } else { [fb, fa, ba] })
     }
+}
+
+/// The first index whose byte differs from `v`, comparing 16 bytes at a time.
+fn first_differing(row: &[u8], v: u8) -> Option<usize> {
+    let chunks = row.chunks_exact(16);
+    let tail = chunks.remainder();
+    for (c, chunk) in chunks.enumerate() {
+        if chunk != [v; 16] {
+            return chunk.iter().position(|&b| b != v).map(|i| c * 16 + i);
+        }
+    }
+    tail.iter()
+        .position(|&b| b != v)
+        .map(|i| row.len() - tail.len() + i)
+}
+
+/// The last index whose byte differs from `v`, comparing 16 bytes at a time.
+fn last_differing(row: &[u8], v: u8) -> Option<usize> {
+    let chunks = row.rchunks_exact(16);
+    let head = chunks.remainder();
+    for (c, chunk) in chunks.enumerate() {
+        if chunk != [v; 16] {
+            let start = row.len() - (c + 1) * 16;
+            return chunk.iter().rposition(|&b| b != v).map(|i| start + i);
+        }
+    }
+    head.iter().rposition(|&b| b != v)
 }

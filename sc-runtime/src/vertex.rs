@@ -33,8 +33,8 @@ impl<T: Scalar> Field<'_, T> {
     }
 
     #[inline]
-    pub fn value(&self, x: usize, y: usize, z: usize) -> f64 {
-        self.slice(z)[x + self.dims[0] * y].to_f64()
+    pub fn value(&self, p: [usize; 3]) -> f64 {
+        self.slice(p[2])[p[0] + self.dims[0] * p[1]].to_f64()
     }
 
     /// Central differences inside, one-sided at the border, divided by spacing.
@@ -44,7 +44,7 @@ impl<T: Scalar> Field<'_, T> {
             let at = |c: usize| {
                 let mut q = p;
                 q[d] = c;
-                self.value(q[0], q[1], q[2])
+                self.value(q)
             };
             let (lo, hi) = (p[d].saturating_sub(1), (p[d] + 1).min(n - 1));
             (at(hi) - at(lo)) / ((hi - lo) as f64 * self.spacing[d])

@@ -133,7 +133,7 @@ pub fn check_entry(p: u8, case: u8, entry: &Entry) -> Result<(), String> {
         .into_iter()
         .filter(|&g| forced_fold(case, g))
         .collect();
-    if (entry.rule == Rule::Demoted) != !forced.is_empty() {
+    if (entry.rule == Rule::Demoted) == forced.is_empty() {
         return Err(format!(
             "rule {} but forced greys {forced:?}",
             entry.rule.name()

@@ -106,23 +106,26 @@ fn run(command: Command) -> Result<(), String> {
         }
         Command::Verify { tables } => {
             let committed = load(&tables)?;
-            let fresh = generate(&committed.order)?;
-            let fresh_default =
-                (committed.order != ORDER0).then(|| "the order differs from the built-in one; ");
-            let diffs = dump::diff(&committed, &fresh);
-            if diffs.is_empty() && fresh_default.is_none() && committed.to_ron() == fresh.to_ron() {
+            let fresh = generate(&ORDER0)?;
+            if committed.to_ron() == fresh.to_ron() {
                 println!(
                     "{} matches fresh generation (2048 entries)",
                     tables.display()
                 );
                 return Ok(());
             }
-            let mut msg = format!(
-                "{} differs from fresh generation: {}{} entries differ; run `sc-tablegen generate`",
-                tables.display(),
-                fresh_default.unwrap_or(""),
+            let diffs = dump::diff(&committed, &fresh);
+            let mut msg = format!("{} differs from fresh generation: ", tables.display());
+            if committed.order != fresh.order {
+                msg.push_str(&format!(
+                    "order {:?} vs built-in {:?}; ",
+                    committed.order, fresh.order
+                ));
+            }
+            msg.push_str(&format!(
+                "{} entries differ; run `sc-tablegen generate` and commit tables/",
                 diffs.len()
-            );
+            ));
             for d in diffs.iter().take(20) {
                 msg.push_str("\n  ");
                 msg.push_str(d);
