@@ -74,7 +74,7 @@ fn build_entry(nine: &[u8; 9], p: u8, case: u8) -> Result<Entry, String> {
             }
         }
         // SPEC §4's last resort: any greys-first order, the rest in lexicographic order.
-        let found = greys_first_orders(&class_order(nine, p, Rule::Base))
+        let found = orders_keeping(class_order(nine, p, Rule::Base), 3)
             .map(|order| nibble(&loops, &order))
             .find(|n| acceptable(n))
             .ok_or("no greys-first order is fold-free and embedded")?;
@@ -88,7 +88,16 @@ fn build_entry(nine: &[u8; 9], p: u8, case: u8) -> Result<Entry, String> {
         });
     }
 
+    let last_resort = {
+        let mut base: Vec<u8> = class_order(nine, p, Rule::Base)
+            .into_iter()
+            .filter(|e| !forced.contains(e))
+            .collect();
+        base.extend(&forced);
+        orders_keeping(base.try_into().expect("12 edges"), 3 - forced.len())
+    };
     let demoted = demoted_orders(nine, p, &forced)
+        .chain(last_resort)
         .map(|order| nibble(&loops, &order))
         .find(|n| acceptable(n))
         .ok_or("no order with the forced greys demoted is fold-free and embedded")?;
@@ -138,18 +147,18 @@ fn demoted_orders<'a>(
     })
 }
 
-/// Every order that keeps `base`'s first three edges first, the other nine permuted in
-/// lexicographic order of their positions in `base`.
-fn greys_first_orders(base: &[u8; 12]) -> impl Iterator<Item = [u8; 12]> + '_ {
-    let mut perm: [usize; 9] = core::array::from_fn(|i| i);
+/// Every order that keeps `base`'s first `keep` edges first, the rest permuted in lexicographic
+/// order of their positions in `base`.
+fn orders_keeping(base: [u8; 12], keep: usize) -> impl Iterator<Item = [u8; 12]> {
+    let mut perm: Vec<usize> = (keep..12).collect();
     let mut done = false;
     core::iter::from_fn(move || {
         if done {
             return None;
         }
-        let mut order = *base;
+        let mut order = base;
         for (i, &k) in perm.iter().enumerate() {
-            order[3 + i] = base[3 + k];
+            order[keep + i] = base[k];
         }
         done = !next_permutation(&mut perm);
         Some(order)
