@@ -51,7 +51,13 @@ pub fn optimize(
     }
     let mut results = vec![];
     for (n, order) in orders.iter().enumerate() {
-        let set = sc_tablegen::build(order).map_err(|e| format!("order {order:?}: {}", e[0]))?;
+        let set = match sc_tablegen::build(order) {
+            Ok(set) => set,
+            Err(e) => {
+                eprintln!("  skipping order {order:?}: {}", e[0]);
+                continue;
+            }
+        };
         let lengths: Vec<f64> = vols.iter().map(|v| interior_length(&set, v)).collect();
         let total: f64 = lengths.iter().sum();
         results.push((total, *order, lengths));
