@@ -4,7 +4,7 @@
 //! included) while the crate compiles, so the runtime never parses, allocates or lazily builds a
 //! table, and a broken table is a compile error naming the file, the entry and the problem.
 //!
-//! ```ignore
+//! ```text
 //! // The committed tables, relative to the invoking crate's Cargo.toml:
 //! static TABLES: sc_runtime::tables::CaseTables = sc_macros::include_tables!("../tables/skeleton-climbing.ron");
 //! // Tables a build script wrote into OUT_DIR:
@@ -51,12 +51,18 @@ impl Parse for Input {
 /// Expands to a `sc_runtime::tables::CaseTables` constant expression built from a RON file.
 #[proc_macro]
 pub fn include_tables(input: TokenStream) -> TokenStream {
-    let input = syn::parse_macro_input!(input as Input);
+    include_tables_tokens(input.into()).into()
+}
+
+/// The macro on `proc_macro2` tokens, so tests can check its output, errors included.
+fn include_tables_tokens(input: Tokens) -> Tokens {
+    let input: Input = match syn::parse2(input) {
+        Ok(i) => i,
+        Err(e) => return e.to_compile_error(),
+    };
     match expand(&input) {
-        Ok(tokens) => tokens.into(),
-        Err(msg) => syn::Error::new(input.path.span(), msg)
-            .to_compile_error()
-            .into(),
+        Ok(tokens) => tokens,
+        Err(msg) => syn::Error::new(input.path.span(), msg).to_compile_error(),
     }
 }
 
@@ -164,3 +170,103 @@ fn packed(triangles: &[[u8; 3]], grey: &[Grey]) -> Tokens {
 
 /// Mirrors `sc_runtime::tables::NO_EAR` (the macro cannot depend on the runtime it feeds).
 const NO_EAR: u8 = 0xFF;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn committed() -> TableSet {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tables/skeleton-climbing.ron"
+        );
+        TableSet::from_ron(&std::fs::read_to_string(path).unwrap()).unwrap()
+    }
+
+    /// Expands the macro on a RON text written to a temporary file; returns the output tokens
+    /// as a string and the file's path.
+    fn expand_text(name: &str, ron: &str) -> (String, String) {
+        let dir = std::env::temp_dir().join(format!("sc-macros-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, ron).unwrap();
+        let shown = path.display().to_string();
+        let out = include_tables_tokens(quote!(#shown)).to_string();
+        (out, shown)
+    }
+
+    /// The macro must give a `compile_error!` that names the file, the entry and the problem.
+    fn assert_compile_error(out: &str, needles: &[&str]) {
+        assert!(
+            out.contains("compile_error"),
+            "expected compile_error!, got: {}",
+            &out[..out.len().min(300)]
+        );
+        for n in needles {
+            assert!(out.contains(n), "message lacks {n:?}: {out}");
+        }
+    }
+
+    #[test]
+    fn committed_tables_expand_to_static_arrays() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tables/skeleton-climbing.ron"
+        );
+        let out = include_tables_tokens(quote!(#path)).to_string();
+        assert!(!out.contains("compile_error"));
+        assert!(
+            out.contains("static EMBEDDED")
+                && out.contains("static PAPER")
+                && out.contains("include_bytes")
+        );
+        assert_eq!(out.matches("Entry {").count(), 4096);
+    }
+
+    #[test]
+    fn wrong_entry_count_names_the_class() {
+        let mut set = committed();
+        set.classes[3].cases.pop();
+        let (out, file) = expand_text("short.ron", &set.to_ron());
+        assert_compile_error(&out, &[&file, "class 3", "255 entries"]);
+    }
+
+    #[test]
+    fn edge_id_over_eleven_names_the_entry() {
+        let mut set = committed();
+        set.classes[2].cases[7].triangles[0][1] = 12;
+        let (out, file) = expand_text("edge.ron", &set.to_ron());
+        assert_compile_error(&out, &[&file, "class 2 case 7", "edge id 12 > 11"]);
+    }
+
+    #[test]
+    fn too_many_triangles_names_the_entry() {
+        let mut set = committed();
+        let extra = set.classes[0].cases[254].triangles[0];
+        set.classes[0].cases[254].triangles.extend([extra; 5]);
+        let (out, file) = expand_text("many.ron", &set.to_ron());
+        assert_compile_error(&out, &[&file, "class 0 case 254", "at most 5"]);
+    }
+
+    #[test]
+    fn inconsistent_triangles_fail_validation() {
+        let mut set = committed();
+        // Reversing one triangle breaks the face-side orientation check.
+        set.classes[5].cases[1].triangles[0].reverse();
+        let (out, file) = expand_text("flipped.ron", &set.to_ron());
+        assert_compile_error(&out, &[&file, "class 5 case 1", "face side"]);
+    }
+
+    #[test]
+    fn malformed_ron_and_missing_files_are_errors() {
+        let (out, file) = expand_text("broken.ron", "(order: [0, 1,");
+        assert_compile_error(&out, &[&file, "malformed tables"]);
+        let out = include_tables_tokens(quote!("/nonexistent/tables.ron")).to_string();
+        assert_compile_error(
+            &out,
+            &["cannot read tables file", "/nonexistent/tables.ron"],
+        );
+        let out = include_tables_tokens(quote!(in_dir "x.ron")).to_string();
+        assert_compile_error(&out, &["out_dir"]);
+    }
+}
