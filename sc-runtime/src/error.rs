@@ -17,6 +17,8 @@ pub enum Error {
     TooManyVertices,
     /// A scratch buffer is smaller than [`crate::Scratch::len`] requires.
     ScratchTooSmall,
+    /// The worker threads could not be started.
+    ThreadPool,
     /// A streamed slice does not hold `nx · ny` values, or more than `nz` slices were pushed.
     SliceLength {
         /// `nx · ny`.
@@ -45,6 +47,7 @@ impl fmt::Display for Error {
             Error::ScratchTooSmall => {
                 f.write_str("scratch buffers are too small for these dimensions")
             }
+            Error::ThreadPool => f.write_str("could not start the worker threads"),
             Error::SliceLength { expected, actual } => {
                 write!(f, "expected a slice of {expected} samples, got {actual}")
             }

@@ -44,7 +44,7 @@ pub fn extract_par<T: Scalar>(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|_| Error::TooManyVertices)?;
+        .map_err(|_| Error::ThreadPool)?;
     let layers = dims[2] - 1;
     let workers = pool.current_num_threads();
     // A few chunks per thread balance uneven surfaces without much re-reading at the seams.
