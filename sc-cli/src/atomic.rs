@@ -1,0 +1,185 @@
+//! Output files appear whole or not at all: content goes to a temporary file in the target's
+//! directory (so the final rename cannot cross file systems) and is renamed over the target only
+//! once complete. An error drops the temporary file; Ctrl-C removes it before exiting.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use tempfile::NamedTempFile;
+
+use crate::error::{Error, Result};
+
+/// Temporary files not yet renamed, for the Ctrl-C handler to remove.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Makes Ctrl-C (and SIGTERM) remove pending temporary files and exit with status 130. Without
+/// it the rename never happens, so the target is safe anyway, but a stray `.tmp` would remain.
+pub fn remove_temporaries_on_interrupt() {
+    // Failing to install the handler only loses the clean-up, never correctness: ignore it.
+    let _ = ctrlc::set_handler(|| {
+        if let Ok(pending) = PENDING.lock() {
+            for path in pending.iter() {
+                let _ = std::fs::remove_file(path);
+            }
+        }
+        eprintln!("interrupted");
+        std::process::exit(130);
+    });
+}
+
+/// A file being written to a temporary name beside `target`.
+pub struct AtomicFile {
+    temp: NamedTempFile,
+    target: PathBuf,
+    _pending: Pending,
+}
+
+/// Keeps a temporary file's path in [`PENDING`] while it exists.
+struct Pending(PathBuf);
+
+impl Pending {
+    fn new(path: &Path) -> Self {
+        if let Ok(mut pending) = PENDING.lock() {
+            pending.push(path.to_path_buf());
+        }
+        Pending(path.to_path_buf())
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        if let Ok(mut pending) = PENDING.lock() {
+            pending.retain(|p| *p != self.0);
+        }
+    }
+}
+
+impl AtomicFile {
+    /// Creates the temporary file now, so that a missing or unwritable directory is reported
+    /// before any slow work.
+    pub fn create(target: &Path) -> Result<Self> {
+        if target.is_dir() {
+            return Err(Error::file(target, "is a directory"));
+        }
+        let dir = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if !dir.is_dir() {
+            return Err(Error::file(
+                target,
+                format!("the directory {} does not exist", dir.display()),
+            ));
+        }
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let temp = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".tmp")
+            .tempfile_in(dir)
+            .map_err(|e| {
+                Error::file(
+                    target,
+                    format!(
+                        "cannot create a file in {}: {}",
+                        dir.display(),
+                        io_reason(&e)
+                    ),
+                )
+            })?;
+        let pending = Pending::new(temp.path());
+        Ok(AtomicFile {
+            temp,
+            target: target.to_path_buf(),
+            _pending: pending,
+        })
+    }
+
+    /// Writes the content with `fill` through a buffer, then renames the file over the target.
+    pub fn write_with(
+        self,
+        fill: impl FnOnce(&mut BufWriter<&File>) -> io::Result<()>,
+    ) -> Result<()> {
+        let target = self.target.clone();
+        let fail = |e: io::Error| Error::file(&target, format!("cannot write: {}", io_reason(&e)));
+        let mut out = BufWriter::with_capacity(1 << 20, self.temp.as_file());
+        fill(&mut out).map_err(fail)?;
+        out.flush().map_err(fail)?;
+        drop(out);
+        self.temp.as_file().sync_all().map_err(fail)?;
+        self.temp
+            .persist(&self.target)
+            .map(drop)
+            .map_err(|e| fail(e.error))
+    }
+}
+
+fn io_reason(e: &io::Error) -> String {
+    match e.kind() {
+        io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn success_leaves_only_the_target() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("a.ply");
+        AtomicFile::create(&target)
+            .unwrap()
+            .write_with(|w| w.write_all(b"hello"))
+            .unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"hello");
+        assert_eq!(entries(dir.path()), ["a.ply"]);
+    }
+
+    #[test]
+    fn failure_leaves_nothing_and_keeps_an_old_target() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("a.ply");
+        std::fs::write(&target, b"old").unwrap();
+        let err = AtomicFile::create(&target)
+            .unwrap()
+            .write_with(|w| {
+                w.write_all(b"partial")?;
+                Err(io::Error::other("disk full"))
+            })
+            .unwrap_err();
+        assert!(err.to_string().contains("disk full"), "{err}");
+        assert_eq!(std::fs::read(&target).unwrap(), b"old");
+        assert_eq!(entries(dir.path()), ["a.ply"]);
+    }
+
+    #[test]
+    fn dropped_before_writing_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        drop(AtomicFile::create(&dir.path().join("a.ply")).unwrap());
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn missing_directory_is_reported_up_front() {
+        let dir = tempfile::tempdir().unwrap();
+        let Err(err) = AtomicFile::create(&dir.path().join("no/such/dir/a.ply")) else {
+            panic!()
+        };
+        assert!(err.to_string().contains("does not exist"), "{err}");
+    }
+}

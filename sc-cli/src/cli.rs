@@ -1,0 +1,290 @@
+//! The command line. Everything clap can check is checked here, so that usage errors exit with
+//! status 2 before any file is read.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use sc_runtime::Mode;
+
+use crate::read::{RawLayout, ReadOptions};
+use crate::volume::{Dtype, Endian};
+use crate::write::MeshFormat;
+
+/// Skeleton Climbing isosurfaces from volume files.
+///
+/// Skeleton Climbing (Poston, Wong, Heng 1998) meshes the surface `f = iso` of a sampled volume
+/// like Marching Cubes, then merges triangles around a fixed set of grid edges, giving a closed
+/// surface with about a quarter fewer triangles.
+#[derive(Debug, Parser)]
+#[command(name = "skelclimb", version, propagate_version = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+    /// No progress bar and no summary; warnings and errors still go to stderr.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Mesh the surface `f = iso` of a volume (or a built-in one) into a .ply, .obj, .stl or .glb.
+    Extract(ExtractArgs),
+    /// Describe a volume: size, type, spacing, values, and iso values worth trying.
+    ///
+    /// Suggested iso values come from the histogram: Otsu's threshold (the split of all values
+    /// into two classes that are as far apart as possible, good for one object against a
+    /// background) and valleys (values rarer than the peaks on both sides, typical of the
+    /// boundary between two tissues or materials).
+    Info(InfoArgs),
+    /// Rerun the paper's Table 1 comparison: triangles and time for Steps 1–3 and Steps 1–4
+    /// (embedded and paper modes) on the built-in volumes and any volumes given.
+    Table1(Table1Args),
+}
+
+/// How to read a volume file; options for raw files are refused for the other formats.
+#[derive(Debug, Args)]
+pub struct InputArgs {
+    /// Raw input: samples along x, y, z, e.g. `256,256,128` (x varies fastest in the file).
+    #[arg(long, value_parser = parse_dims, requires = "dtype", help_heading = "Raw input")]
+    pub dims: Option<[usize; 3]>,
+    /// Raw input: the sample type.
+    #[arg(long, value_enum, requires = "dims", help_heading = "Raw input")]
+    pub dtype: Option<Dtype>,
+    /// Raw input: byte order [default: little].
+    #[arg(long, value_enum, requires = "dims", help_heading = "Raw input")]
+    pub endian: Option<Endian>,
+    /// Raw input: bytes to skip before the samples [default: 0].
+    #[arg(long, requires = "dims", help_heading = "Raw input")]
+    pub header_bytes: Option<u64>,
+    /// .npz input: the array to read (may be left out if there is only one).
+    #[arg(long)]
+    pub array: Option<String>,
+}
+
+impl InputArgs {
+    /// The reader options these arguments give.
+    pub fn read_options(&self) -> ReadOptions {
+        let raw = match (self.dims, self.dtype) {
+            (Some(dims), Some(dtype)) => Some(RawLayout {
+                dims,
+                dtype,
+                endian: self.endian.unwrap_or_default(),
+                header_bytes: self.header_bytes.unwrap_or(0),
+            }),
+            _ => None,
+        };
+        ReadOptions {
+            raw,
+            array: self.array.clone(),
+        }
+    }
+}
+
+/// Arguments of `extract`.
+#[derive(Debug, Args)]
+pub struct ExtractArgs {
+    /// The volume: a .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd, .npy/.npz file, a DICOM directory, or a
+    /// raw file with --dims and --dtype.
+    #[arg(required_unless_present = "demo", conflicts_with = "demo")]
+    pub input: Option<PathBuf>,
+    /// Use a built-in volume instead of a file; `knot` is the paper's knotted torus.
+    #[arg(long, value_enum)]
+    pub demo: Option<Demo>,
+    /// Samples per axis of the built-in volume.
+    #[arg(long, requires = "demo", default_value_t = 64)]
+    pub size: usize,
+    /// The surface value: samples `>= iso` are inside. Required for files (see `skelclimb info`).
+    #[arg(long, allow_negative_numbers = true)]
+    pub iso: Option<f64>,
+    /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format.
+    #[arg(short, long, value_parser = parse_output)]
+    pub output: Output,
+    /// Which steps run: `embedded` merges only where the result stays a closed 2-manifold,
+    /// `paper` merges every interior grey edge as the paper does, `steps123` does not merge.
+    #[arg(long, value_enum, default_value_t = ModeArg::Embedded)]
+    pub mode: ModeArg,
+    /// Leave out per-vertex normals.
+    #[arg(long)]
+    pub no_normals: bool,
+    /// Worker threads; 0 uses every core. The mesh is the same for any number.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Surround the volume with one layer of empty samples, so that every surface is closed.
+    #[arg(long)]
+    pub pad: bool,
+    /// Distance between samples along x, y, z, overriding the file's.
+    #[arg(long, value_parser = parse_spacing)]
+    pub spacing: Option<[f64; 3]>,
+    /// World position of the first sample, overriding the file's.
+    #[arg(long, value_parser = parse_triple, allow_negative_numbers = true)]
+    pub origin: Option<[f64; 3]>,
+    /// Also write the summary as JSON to this file.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
+    /// Write text PLY instead of binary.
+    #[arg(long)]
+    pub ascii: bool,
+    /// How to read the volume.
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+/// Arguments of `info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// The volume (any format `extract` reads).
+    pub input: PathBuf,
+    /// Histogram bins to print.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub bins: u16,
+    /// How to read the volume.
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+/// Arguments of `table1`.
+#[derive(Debug, Args)]
+pub struct Table1Args {
+    /// More volumes, each `FILE@ISO`, or just `FILE` to use its Otsu threshold.
+    pub volumes: Vec<String>,
+    /// Samples per axis of the built-in sphere, torus and noisy sphere (the knot is always 64,
+    /// as in the paper).
+    #[arg(long, default_value_t = 128)]
+    pub size: usize,
+    /// Worker threads; 0 uses every core.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// How to read the volumes.
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+/// The built-in volumes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Demo {
+    /// The paper's knotted torus (Table 1), iso 0.9.
+    Knot,
+    /// A ball.
+    Sphere,
+    /// A ring torus.
+    Torus,
+    /// A ball with noise: many small features, like real scans.
+    SphereNoise,
+}
+
+/// `--mode` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Steps 1–4, merging where the surface stays a closed 2-manifold.
+    Embedded,
+    /// Steps 1–4, merging every interior grey edge, as the paper does.
+    Paper,
+    /// Steps 1–3 only: no merging.
+    Steps123,
+}
+
+impl From<ModeArg> for Mode {
+    fn from(m: ModeArg) -> Mode {
+        match m {
+            ModeArg::Embedded => Mode::Embedded,
+            ModeArg::Paper => Mode::Paper,
+            ModeArg::Steps123 => Mode::Steps123,
+        }
+    }
+}
+
+/// An output path whose extension names a known mesh format.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Output {
+    /// Where to write.
+    pub path: PathBuf,
+    /// What to write.
+    pub format: MeshFormat,
+}
+
+fn parse_output(s: &str) -> Result<Output, String> {
+    let path = PathBuf::from(s);
+    let format = MeshFormat::from_path(&path)?;
+    Ok(Output { path, format })
+}
+
+fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("{x:?} is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err("expected three finite numbers X,Y,Z".into()),
+    }
+}
+
+fn parse_spacing(s: &str) -> Result<[f64; 3], String> {
+    let v = parse_triple(s)?;
+    if v.iter().all(|&c| c > 0.0) {
+        Ok(v)
+    } else {
+        Err("spacings must be positive".into())
+    }
+}
+
+fn parse_dims(s: &str) -> Result<[usize; 3], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<usize>()
+                .map_err(|_| format!("{x:?} is not a whole number"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|&d| d > 0) => Ok([*x, *y, *z]),
+        _ => Err("expected three positive sizes X,Y,Z".into()),
+    }
+}
+
+/// `FILE@ISO` or `FILE`, as `table1` takes them; an `@` not followed by a number is part of
+/// the file name.
+pub fn split_iso(spec: &str) -> (PathBuf, Option<f64>) {
+    match spec
+        .rsplit_once('@')
+        .map(|(path, iso)| (path, iso.parse::<f64>()))
+    {
+        Some((path, Ok(iso))) => (PathBuf::from(path), Some(iso)),
+        _ => (PathBuf::from(spec), None),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    use super::*;
+
+    #[test]
+    fn definitions_are_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn parses_lists() {
+        assert_eq!(parse_dims("3, 4,5"), Ok([3, 4, 5]));
+        assert!(parse_dims("3,0,5").is_err());
+        assert!(parse_dims("3,4").is_err());
+        assert_eq!(parse_triple("-1.5,0,2e3"), Ok([-1.5, 0.0, 2000.0]));
+        assert!(parse_spacing("1,0,1").is_err());
+        assert!(parse_output("a.vtk").is_err());
+        assert_eq!(parse_output("A.GLB").map(|o| o.format), Ok(MeshFormat::Glb));
+        assert_eq!(
+            split_iso("a@b.nii@20"),
+            (PathBuf::from("a@b.nii"), Some(20.0))
+        );
+        assert_eq!(split_iso("a@b.nii"), (PathBuf::from("a@b.nii"), None));
+    }
+}

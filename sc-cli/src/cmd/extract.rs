@@ -1,0 +1,140 @@
+//! `skelclimb extract`.
+
+use std::io::Write;
+use std::time::Instant;
+
+use sc_runtime::{Mesh, Mode};
+
+use super::warn;
+use crate::atomic::AtomicFile;
+use crate::builtin;
+use crate::cli::{Demo, ExtractArgs, ModeArg};
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::read::{self, Format};
+use crate::summary::Summary;
+use crate::surface::{self, Request};
+use crate::write::MeshFormat;
+
+/// Reads, extracts, writes and reports. Output files are opened first, so that a bad output
+/// path fails before a long read, and written whole or not at all.
+pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
+    let options = args.read.read_options();
+    match (&args.input, args.demo) {
+        (Some(input), _) => {
+            Format::detect(input, &options)?;
+            if args.iso.is_none() {
+                return Err(Error::Usage(format!(
+                    "--iso is required for {}; `skelclimb info {}` suggests values",
+                    input.display(),
+                    input.display()
+                )));
+            }
+        }
+        (None, _) if options != read::ReadOptions::default() => {
+            return Err(Error::Usage("--dims, --dtype, --endian, --header-bytes and --array describe input files, not --demo".into()));
+        }
+        _ => {}
+    }
+    if args.ascii && args.output.format != MeshFormat::Ply {
+        return Err(Error::Usage("--ascii applies to .ply output only".into()));
+    }
+    let mesh_file = AtomicFile::create(&args.output.path)?;
+    let stats_file = args
+        .stats_json
+        .as_deref()
+        .map(AtomicFile::create)
+        .transpose()?;
+    let progress = Progress::new(!quiet);
+
+    let clock = Instant::now();
+    let (mut grid, iso, input) = match (&args.input, args.demo) {
+        (Some(path), _) => (
+            read::read(path, &options, &progress)?,
+            args.iso.unwrap_or_default(),
+            path.display().to_string(),
+        ),
+        (None, Some(demo)) => {
+            let (grid, iso) = builtin::grid(demo, args.size);
+            (
+                grid,
+                args.iso.unwrap_or(iso),
+                format!("{} {}³", builtin::name(demo), args.size),
+            )
+        }
+        (None, None) => return Err(Error::Usage("give an input volume or --demo".into())),
+    };
+    let read_time = clock.elapsed();
+    if let Some(spacing) = args.spacing {
+        grid.spacing = spacing;
+    }
+    if let Some(origin) = args.origin {
+        grid.origin = origin;
+    }
+    if args.pad {
+        grid.pad(iso).map_err(|e| Error::file(&input, e))?;
+    }
+
+    let clock = Instant::now();
+    let range = grid.range();
+    let mesh = match surface::why_empty(&range, iso) {
+        Some(why) => {
+            warn(format!("{input}: {why}; writing an empty mesh"));
+            Mesh::default()
+        }
+        None => {
+            let request = Request {
+                iso,
+                mode: args.mode.into(),
+                normals: !args.no_normals,
+                threads: args.threads,
+            };
+            surface::extract(&grid, &request, &progress)?
+        }
+    };
+    let extract_time = clock.elapsed();
+    let is_paper_knot =
+        args.demo == Some(Demo::Knot) && args.size == 64 && args.iso.is_none_or(|i| i == iso);
+    let paper_knot = match args.mode {
+        _ if !is_paper_knot => None,
+        ModeArg::Paper => Some(mesh.stats.triangles),
+        _ => {
+            let request = Request {
+                iso,
+                mode: Mode::Paper,
+                normals: false,
+                threads: args.threads,
+            };
+            Some(
+                surface::extract(&grid, &request, &Progress::hidden())?
+                    .stats
+                    .triangles,
+            )
+        }
+    };
+    progress.finish();
+
+    let clock = Instant::now();
+    mesh_file.write_with(|out| args.output.format.write(&mesh, args.ascii, out))?;
+    let summary = Summary {
+        input,
+        format: grid.format,
+        dims: grid.dims,
+        dtype: grid.samples.dtype().name(),
+        iso,
+        mode: args.mode.into(),
+        stats: mesh.stats,
+        read: read_time,
+        extract: extract_time,
+        write: clock.elapsed(),
+        paper_knot,
+    };
+    if let Some(file) = stats_file {
+        let json = serde_json::to_vec_pretty(&summary.to_json()).map_err(std::io::Error::other);
+        file.write_with(|out| out.write_all(&json?))?;
+    }
+    if !quiet {
+        println!("{summary}");
+    }
+    Ok(())
+}

@@ -1,0 +1,163 @@
+//! `skelclimb info`.
+
+use std::fmt::Write as _;
+
+use crate::cli::InfoArgs;
+use crate::error::Result;
+use crate::histogram::Histogram;
+use crate::progress::Progress;
+use crate::read;
+use crate::summary::thousands;
+use crate::volume::{Dtype, Grid};
+
+/// Bins behind the suggestions: fine enough to separate tissues, coarse enough to smooth noise.
+const SUGGESTION_BINS: usize = 128;
+
+/// Prints what is known about the volume and which iso values to try.
+pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
+    let progress = Progress::new(!quiet);
+    let grid = read::read(&args.input, &args.read.read_options(), &progress)?;
+    progress.finish();
+    print!(
+        "{}",
+        describe(
+            &args.input.display().to_string(),
+            &grid,
+            usize::from(args.bins)
+        )
+    );
+    Ok(())
+}
+
+/// The report, as text.
+pub fn describe(name: &str, grid: &Grid, bins: usize) -> String {
+    let mut out = String::new();
+    let [nx, ny, nz] = grid.dims;
+    let [sx, sy, sz] = grid.spacing;
+    let [ox, oy, oz] = grid.origin;
+    let range = grid.range();
+    let shown = Histogram::of(grid, &range, bins);
+    let fine = Histogram::of(grid, &range, SUGGESTION_BINS);
+    // `fmt::Write` for `String` cannot fail.
+    let _ = writeln!(out, "{name}");
+    let _ = writeln!(out, "  format    {}", grid.format);
+    let _ = writeln!(
+        out,
+        "  dims      {nx} × {ny} × {nz} ({} samples)",
+        thousands(grid.len() as u64)
+    );
+    let _ = writeln!(out, "  dtype     {}", grid.samples.dtype().name());
+    if !grid.scale.is_identity() {
+        let _ = writeln!(
+            out,
+            "  rescale   value = {} × stored + {}",
+            grid.scale.slope, grid.scale.inter
+        );
+    }
+    let _ = writeln!(
+        out,
+        "  spacing   {} × {} × {}",
+        short(sx),
+        short(sy),
+        short(sz)
+    );
+    let _ = writeln!(
+        out,
+        "  origin    {}, {}, {}",
+        short(ox),
+        short(oy),
+        short(oz)
+    );
+    if range.finite == 0 {
+        let _ = writeln!(
+            out,
+            "  values    none finite ({} NaN)",
+            thousands(range.nan as u64)
+        );
+    } else {
+        let _ = writeln!(
+            out,
+            "  values    {} to {}, mean {}",
+            short(range.min),
+            short(range.max),
+            short(shown.mean)
+        );
+        if range.nan > 0 {
+            let _ = writeln!(
+                out,
+                "  NaN       {} samples (outside every surface)",
+                thousands(range.nan as u64)
+            );
+        }
+        let _ = writeln!(out, "  histogram (bar length ∝ log count)");
+        let widest = shown.counts.iter().map(|&c| ln1p(c)).fold(0.0, f64::max);
+        for (i, &c) in shown.counts.iter().enumerate() {
+            let bar = if widest > 0.0 {
+                (40.0 * ln1p(c) / widest).round() as usize
+            } else {
+                0
+            };
+            let _ = writeln!(
+                out,
+                "    {:>10} … {:<10} {:<40} {}",
+                short(shown.edge(i)),
+                short(shown.edge(i + 1)),
+                "█".repeat(bar),
+                thousands(c)
+            );
+        }
+        // Integer samples never equal a value halfway between integers, which keeps vertices off
+        // grid points (SPEC §1).
+        let integer =
+            grid.scale.is_identity() && !matches!(grid.samples.dtype(), Dtype::F32 | Dtype::F64);
+        let snap = |x: f64| if integer { x.floor() + 0.5 } else { x };
+        let _ = writeln!(
+            out,
+            "  suggested iso values{}",
+            if integer {
+                " (halfway between integers)"
+            } else {
+                ""
+            }
+        );
+        if let Some(t) = fine.otsu() {
+            let _ = writeln!(
+                out,
+                "    {:<10} Otsu threshold: best split into two classes of values",
+                short(snap(t))
+            );
+        }
+        for (v, l, r) in fine.valleys(3) {
+            let _ = writeln!(
+                out,
+                "    {:<10} histogram valley between peaks near {} and {}",
+                short(snap(v)),
+                short(l),
+                short(r)
+            );
+        }
+    }
+    for note in &grid.notes {
+        let _ = writeln!(out, "  note      {note}");
+    }
+    out
+}
+
+/// A value for reading: at most four decimals, no trailing zeros, no negative zero.
+fn short(x: f64) -> String {
+    let text = format!("{:.4}", x + 0.0);
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &text
+    };
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+fn ln1p(c: u64) -> f64 {
+    (c as f64).ln_1p()
+}

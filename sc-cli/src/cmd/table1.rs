@@ -1,0 +1,100 @@
+//! `skelclimb table1`: the paper's Table 1 comparison, rerun.
+
+use std::time::{Duration, Instant};
+
+use sc_runtime::Mode;
+
+use crate::builtin;
+use crate::cli::{Demo, Table1Args, split_iso};
+use crate::error::{Error, Result};
+use crate::histogram::Histogram;
+use crate::progress::Progress;
+use crate::read;
+use crate::summary::{PAPER_KNOT, thousands};
+use crate::surface::{self, Request};
+use crate::volume::Grid;
+
+const MODES: [Mode; 3] = [Mode::Steps123, Mode::Embedded, Mode::Paper];
+
+/// Runs each volume in the three modes and prints one row per volume.
+pub fn run(args: &Table1Args, quiet: bool) -> Result<()> {
+    let options = args.read.read_options();
+    let files: Vec<_> = args.volumes.iter().map(|v| split_iso(v)).collect();
+    for (path, _) in &files {
+        read::Format::detect(path, &options)?;
+    }
+    let progress = Progress::new(!quiet);
+    println!(
+        "{:<34}{:>22}{:>22}{:>22}",
+        "triangles (time)", "Steps 1–3", "Steps 1–4 embedded", "Steps 1–4 paper"
+    );
+    for demo in [Demo::Knot, Demo::Sphere, Demo::Torus, Demo::SphereNoise] {
+        let n = if demo == Demo::Knot { 64 } else { args.size };
+        let (grid, iso) = builtin::grid(demo, n);
+        row(
+            &format!("{} {n}³ (iso {iso})", builtin::name(demo)),
+            &grid,
+            iso,
+            args.threads,
+            &progress,
+        )?;
+        if demo == Demo::Knot {
+            let [mc, t13, t14] = PAPER_KNOT.map(thousands);
+            println!(
+                "{:<34}{:>22}{:>22}{:>22}",
+                format!("  the paper (Marching Cubes {mc})"),
+                t13,
+                "",
+                t14
+            );
+        }
+    }
+    for (path, iso) in files {
+        let grid = read::read(&path, &options, &progress)?;
+        let iso = match iso {
+            Some(iso) => iso,
+            None => Histogram::of(&grid, &grid.range(), 128)
+                .otsu()
+                .ok_or_else(|| {
+                    Error::file(&path, "no Otsu threshold (constant volume?): give FILE@ISO")
+                })?,
+        };
+        row(
+            &format!("{} (iso {iso})", path.display()),
+            &grid,
+            iso,
+            args.threads,
+            &progress,
+        )?;
+    }
+    progress.finish();
+    Ok(())
+}
+
+fn row(label: &str, grid: &Grid, iso: f64, threads: usize, progress: &Progress) -> Result<()> {
+    let mut cells = Vec::new();
+    for mode in MODES {
+        let request = Request {
+            iso,
+            mode,
+            normals: false,
+            threads,
+        };
+        let clock = Instant::now();
+        let mesh = surface::extract(grid, &request, progress)?;
+        cells.push(format!(
+            "{} ({})",
+            thousands(mesh.stats.triangles),
+            millis(clock.elapsed())
+        ));
+    }
+    println!(
+        "{label:<34}{:>22}{:>22}{:>22}",
+        cells[0], cells[1], cells[2]
+    );
+    Ok(())
+}
+
+fn millis(d: Duration) -> String {
+    format!("{:.1} ms", d.as_secs_f64() * 1e3)
+}

@@ -1,0 +1,221 @@
+//! Volume readers. Each format parses its own header (with a crate where a good one exists) and
+//! hands the sample block to [`read_block`], so that byte order, compression, truncation and
+//! progress are handled once.
+
+pub mod dicom;
+pub mod header;
+pub mod metaimage;
+pub mod nifti;
+pub mod npy;
+pub mod nrrd;
+pub mod payload;
+pub mod raw;
+
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::volume::{Dtype, Endian, Grid, Samples};
+use payload::{Encoding, Layout};
+
+/// How to read a headerless file, from the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RawLayout {
+    /// `[nx, ny, nz]`, x fastest.
+    pub dims: [usize; 3],
+    /// Sample type.
+    pub dtype: Dtype,
+    /// Byte order.
+    pub endian: Endian,
+    /// Bytes to skip before the samples.
+    pub header_bytes: u64,
+}
+
+/// Reader options from the command line that only some formats accept.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Layout of a raw file; required for raw input, refused for any other.
+    pub raw: Option<RawLayout>,
+    /// Array name inside an `.npz` archive.
+    pub array: Option<String>,
+}
+
+/// The input formats, told apart by extension (a directory is a DICOM series).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Headerless samples described by `--dims`/`--dtype`.
+    Raw(RawLayout),
+    /// NIfTI-1, `.nii` or `.nii.gz`.
+    Nifti,
+    /// NRRD, `.nrrd` or `.nhdr`.
+    Nrrd,
+    /// MetaImage, `.mha` or `.mhd`.
+    MetaImage,
+    /// NumPy `.npy`.
+    Npy,
+    /// NumPy `.npz`.
+    Npz,
+    /// A directory of DICOM slices.
+    Dicom,
+}
+
+impl Format {
+    /// The format of `path`, or a usage error if options and format do not fit together.
+    pub fn detect(path: &Path, options: &ReadOptions) -> Result<Format> {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let ends = |suffixes: &[&str]| suffixes.iter().any(|s| name.ends_with(s));
+        let format = if path.is_dir() {
+            Format::Dicom
+        } else if ends(&[".nii", ".nii.gz"]) {
+            Format::Nifti
+        } else if ends(&[".nrrd", ".nhdr"]) {
+            Format::Nrrd
+        } else if ends(&[".mha", ".mhd"]) {
+            Format::MetaImage
+        } else if ends(&[".npy"]) {
+            Format::Npy
+        } else if ends(&[".npz"]) {
+            Format::Npz
+        } else if let Some(layout) = options.raw {
+            Format::Raw(layout)
+        } else if ends(&[".dcm"]) {
+            return Err(Error::Usage(format!(
+                "{}: give the directory that holds the DICOM series, not one slice",
+                path.display()
+            )));
+        } else {
+            return Err(Error::Usage(format!(
+                "{}: unknown volume format; expected .nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, \
+                 .npy, .npz, a DICOM directory, or raw samples with --dims and --dtype",
+                path.display()
+            )));
+        };
+        if options.raw.is_some() && !matches!(format, Format::Raw(_)) {
+            return Err(Error::Usage(format!(
+                "--dims/--dtype/--endian/--header-bytes describe raw files; {} has its own header",
+                path.display()
+            )));
+        }
+        if options.array.is_some() && format != Format::Npz {
+            return Err(Error::Usage(
+                "--array selects an array in an .npz file".into(),
+            ));
+        }
+        Ok(format)
+    }
+
+    /// The name shown in summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Raw(_) => "raw",
+            Format::Nifti => "NIfTI-1",
+            Format::Nrrd => "NRRD",
+            Format::MetaImage => "MetaImage",
+            Format::Npy => "NumPy .npy",
+            Format::Npz => "NumPy .npz",
+            Format::Dicom => "DICOM series",
+        }
+    }
+}
+
+/// Reads the volume at `path` in whatever format it is.
+pub fn read(path: &Path, options: &ReadOptions, progress: &Progress) -> Result<Grid> {
+    let format = Format::detect(path, options)?;
+    if !path.exists() {
+        return Err(Error::file(path, "no such file or directory"));
+    }
+    let mut grid = match format {
+        Format::Raw(layout) => raw::read(path, &layout, progress),
+        Format::Nifti => nifti::read(path, progress),
+        Format::Nrrd => nrrd::read(path, progress),
+        Format::MetaImage => metaimage::read(path, progress),
+        Format::Npy | Format::Npz => npy::read(path, options.array.as_deref(), progress),
+        Format::Dicom => dicom::read(path, progress),
+    }?;
+    grid.format = format.name();
+    Ok(grid)
+}
+
+/// Where a sample block starts in its file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// At this byte offset.
+    At(u64),
+    /// At the end minus the block's size: NRRD `byte skip: -1`, MetaImage `HeaderSize = -1`.
+    End,
+}
+
+/// A sample block inside a file.
+pub struct Block<'a> {
+    /// The file holding the samples.
+    pub path: &'a Path,
+    /// Where the (possibly compressed) data starts.
+    pub start: Start,
+    /// Text lines to skip at `start` (NRRD `line skip`).
+    pub skip_lines: usize,
+    /// How the data is stored.
+    pub encoding: Encoding,
+    /// Decoded bytes to skip before the samples (NRRD `byte skip` of compressed data, and the
+    /// NIfTI header inside a `.nii.gz`).
+    pub skip_decoded: u64,
+    /// The samples.
+    pub layout: Layout,
+}
+
+/// Reads a sample block, with errors that name the data file and say what is missing.
+pub fn read_block(block: &Block<'_>, progress: &Progress) -> Result<Samples> {
+    let path = block.path;
+    let need = block
+        .layout
+        .bytes()
+        .ok_or_else(|| Error::file(path, "the volume is too large"))? as u64;
+    let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    let start = match block.start {
+        Start::At(offset) => offset,
+        Start::End => len.saturating_sub(need),
+    };
+    if block.encoding == Encoding::Raw && block.skip_lines == 0 && len < start + need {
+        return Err(Error::file(
+            path,
+            format!(
+                "the file has {len} bytes, but {} samples of {} starting at byte {start} need {} \
+                 (truncated file, or dimensions larger than the data?)",
+                block.layout.count,
+                block.layout.dtype.name(),
+                start + need
+            ),
+        ));
+    }
+    file.seek(SeekFrom::Start(start))
+        .map_err(|e| Error::io(path, e))?;
+    let mut reader = BufReader::with_capacity(1 << 20, file);
+    for _ in 0..block.skip_lines {
+        reader.skip_until(b'\n').map_err(|e| Error::io(path, e))?;
+    }
+    let mut decoded = payload::decode(reader, block.encoding);
+    let skipped = io::copy(
+        &mut (&mut decoded).take(block.skip_decoded),
+        &mut io::sink(),
+    );
+    let result = skipped.and_then(|n| {
+        if n < block.skip_decoded {
+            Err(io::Error::new(
+                io::ErrorKind::UnexpectedEof,
+                "the data ends before the samples start",
+            ))
+        } else {
+            payload::read_samples(decoded, block.layout, progress)
+        }
+    });
+    result.map_err(|e| match (block.encoding, e.kind()) {
+        (Encoding::Raw, _) | (_, io::ErrorKind::UnexpectedEof) => Error::io(path, e),
+        (Encoding::Gzip, _) => Error::file(path, format!("corrupt gzip data: {e}")),
+        (Encoding::Zlib, _) => Error::file(path, format!("corrupt zlib data: {e}")),
+    })
+}

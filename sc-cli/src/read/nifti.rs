@@ -1,0 +1,134 @@
+//! NIfTI-1 single files (`.nii`, `.nii.gz`). The `nifti` crate parses and validates the header;
+//! the samples go through [`read_block`] so that they land in their typed vector with one copy
+//! (the crate's volume types would hold a byte buffer and convert it again).
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use nifti::{Endianness, NiftiHeader, NiftiType};
+
+use super::payload::{Encoding, Layout};
+use super::{Block, Start, read_block};
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::volume::{Dtype, Endian, Grid};
+
+/// Reads a NIfTI-1 volume. Spacing comes from pixdim; the origin from the sform translation, or
+/// the qform offset; scl_slope/scl_inter map stored values to real ones. Rotations in the
+/// affines are not applied to the mesh: `info` reports them.
+pub fn read(path: &Path, progress: &Progress) -> Result<Grid> {
+    let gz = path.to_string_lossy().to_ascii_lowercase().ends_with(".gz");
+    let encoding = if gz { Encoding::Gzip } else { Encoding::Raw };
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let header = NiftiHeader::from_reader(super::payload::decode(BufReader::new(file), encoding))
+        .map_err(|e| Error::file(path, format!("not a readable NIfTI-1 header: {e}")))?;
+    let bad = |message: String| Error::file(path, format!("NIfTI header: {message}"));
+    // The crate takes a wrong sizeof_hdr as a byte-order hint, not as corruption.
+    if header.sizeof_hdr != 348 {
+        return Err(Error::file(
+            path,
+            "not a readable NIfTI-1 header: sizeof_hdr is not 348",
+        ));
+    }
+    if &header.magic != b"n+1\0" {
+        return Err(bad(
+            "this is a header of an .hdr/.img pair; only single .nii files are read".into(),
+        ));
+    }
+    let dims = dims(&header).map_err(bad)?;
+    let dtype = dtype(&header).map_err(bad)?;
+    if !(header.vox_offset >= 348.0 && header.vox_offset.fract() == 0.0) {
+        return Err(bad(format!("vox_offset {} is invalid", header.vox_offset)));
+    }
+    let vox_offset = header.vox_offset as u64;
+    let layout = Layout {
+        dtype,
+        endian: match header.endianness {
+            Endianness::Big => Endian::Big,
+            Endianness::Little => Endian::Little,
+        },
+        count: dims.iter().product(),
+    };
+    let (start, skip_decoded) = if gz {
+        (Start::At(0), vox_offset)
+    } else {
+        (Start::At(vox_offset), 0)
+    };
+    let block = Block {
+        path,
+        start,
+        skip_lines: 0,
+        encoding,
+        skip_decoded,
+        layout,
+    };
+    let mut grid = Grid::new(read_block(&block, progress)?, dims, "NIfTI-1");
+
+    grid.spacing = [1, 2, 3].map(|i| match f64::from(header.pixdim[i]).abs() {
+        s if s.is_finite() && s > 0.0 => s,
+        _ => 1.0,
+    });
+    let slope = f64::from(header.scl_slope);
+    if slope != 0.0 && slope.is_finite() {
+        grid.rescale(slope, f64::from(header.scl_inter));
+    }
+    if header.sform_code > 0 {
+        grid.origin = [header.srow_x[3], header.srow_y[3], header.srow_z[3]].map(f64::from);
+        let rows = [header.srow_x, header.srow_y, header.srow_z];
+        grid.notes.push(format!(
+            "sform (code {}): {} (origin taken from it; rotation and axis flips not applied)",
+            header.sform_code,
+            rows.map(|r| format!("[{} {} {} {}]", r[0], r[1], r[2], r[3]))
+                .join(" ")
+        ));
+    }
+    if header.qform_code > 0 {
+        if header.sform_code <= 0 {
+            grid.origin = [header.quatern_x, header.quatern_y, header.quatern_z].map(f64::from);
+        }
+        grid.notes.push(format!(
+            "qform (code {}): quaternion b,c,d = {}, {}, {}, offset {}, {}, {}, qfac {}",
+            header.qform_code,
+            header.quatern_b,
+            header.quatern_c,
+            header.quatern_d,
+            header.quatern_x,
+            header.quatern_y,
+            header.quatern_z,
+            if header.pixdim[0] < 0.0 { -1 } else { 1 }
+        ));
+    }
+    Ok(grid)
+}
+
+/// The first three dimensions; any further ones (time, components) must be 1.
+fn dims(header: &NiftiHeader) -> Result<[usize; 3], String> {
+    let dim = header.dim().map_err(|e| format!("bad dimensions: {e}"))?;
+    if dim.iter().skip(3).any(|&d| d != 1) {
+        return Err(format!(
+            "dimensions {dim:?}: only single 3-D volumes can be meshed"
+        ));
+    }
+    let at = |i: usize| dim.get(i).map_or(1, |&d| usize::from(d));
+    Ok([at(0), at(1), at(2)])
+}
+
+fn dtype(header: &NiftiHeader) -> Result<Dtype, String> {
+    let t = header
+        .data_type()
+        .map_err(|_| format!("unknown datatype code {}", header.datatype))?;
+    let (kind, bytes) = match t {
+        NiftiType::Uint8 => ('u', 1),
+        NiftiType::Int8 => ('i', 1),
+        NiftiType::Uint16 => ('u', 2),
+        NiftiType::Int16 => ('i', 2),
+        NiftiType::Uint32 => ('u', 4),
+        NiftiType::Int32 => ('i', 4),
+        NiftiType::Float32 => ('f', 4),
+        NiftiType::Float64 => ('f', 8),
+        _ => ('?', 0),
+    };
+    Dtype::from_kind(kind, bytes)
+        .ok_or_else(|| format!("datatype {t:?} (code {}) is not supported: scalar 8- to 32-bit integers and floats are", header.datatype))
+}

@@ -1,0 +1,114 @@
+//! NumPy `.npy` and `.npz`. The `npyz` crate parses the header (and the zip archive); the samples
+//! are read by [`payload::read_samples`] straight into their typed vector.
+//!
+//! Axes: a C-order array of shape `(a, b, c)`, the NumPy default, is indexed `[z, y, x]` with x
+//! varying fastest, so the volume is `nx = c, ny = b, nz = a` and the bytes are used as they are.
+//! A Fortran-order array of shape `(a, b, c)` is `nx = a, ny = b, nz = c`. Either way no sample is
+//! moved; only the shape is read in the right direction.
+
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::Path;
+
+use npyz::npz::NpzArchive;
+use npyz::{DType, NpyHeader, Order, TypeChar};
+
+use super::payload::{self, Layout};
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::volume::{Dtype, Endian, Grid};
+
+/// Reads an `.npy` file, or the array `array` of an `.npz` archive (which may be left out when
+/// the archive holds one array).
+pub fn read(path: &Path, array: Option<&str>, progress: &Progress) -> Result<Grid> {
+    let is_npz = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
+    if !is_npz {
+        let mut file = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+        let header = NpyHeader::from_reader(&mut file)
+            .map_err(|e| Error::file(path, format!("not a readable .npy header: {e}")))?;
+        return read_array(path, &header, file, progress);
+    }
+    let mut archive = NpzArchive::open(path)
+        .map_err(|e| Error::file(path, format!("not a readable .npz archive: {e}")))?;
+    let names: Vec<String> = archive.array_names().map(str::to_owned).collect();
+    let name = match (array, names.as_slice()) {
+        (Some(name), _) => name.to_owned(),
+        (None, [only]) => only.clone(),
+        (None, _) => {
+            return Err(Error::file(
+                path,
+                format!(
+                    "the archive holds arrays {}: choose one with --array",
+                    names.join(", ")
+                ),
+            ));
+        }
+    };
+    match archive.by_name(&name) {
+        Ok(Some(npy)) => read_array(path, &npy.header().clone(), npy.into_inner(), progress),
+        Ok(None) => Err(Error::file(
+            path,
+            format!(
+                "no array named {name:?}; the archive holds {}",
+                names.join(", ")
+            ),
+        )),
+        Err(e) => Err(Error::file(path, format!("array {name:?}: {e}"))),
+    }
+}
+
+fn read_array(
+    path: &Path,
+    header: &NpyHeader,
+    reader: impl Read,
+    progress: &Progress,
+) -> Result<Grid> {
+    let bad = |message: String| Error::file(path, message);
+    let DType::Plain(ty) = header.dtype() else {
+        return Err(bad(format!(
+            "dtype {} is structured; a plain numeric array is needed",
+            header.dtype().descr()
+        )));
+    };
+    let kind = match ty.type_char() {
+        TypeChar::Int => 'i',
+        TypeChar::Uint | TypeChar::Bool => 'u',
+        TypeChar::Float => 'f',
+        _ => '?',
+    };
+    let bytes = usize::try_from(ty.size_field()).unwrap_or(0);
+    let dtype = Dtype::from_kind(kind, bytes).ok_or_else(|| {
+        bad(format!(
+            "dtype {ty} is not supported: 8- to 32-bit integers and floats are"
+        ))
+    })?;
+    let shape = header.shape();
+    let dims: [usize; 3] = match (shape, header.order()) {
+        ([a, b, c], Order::C) => [*c, *b, *a],
+        ([a, b, c], Order::Fortran) => [*a, *b, *c],
+        _ => {
+            return Err(bad(format!(
+                "the array has shape {shape:?}; a 3-D array is needed"
+            )));
+        }
+    }
+    .map(|d| usize::try_from(d).unwrap_or(usize::MAX));
+    let endian = match ty.endianness() {
+        npyz::Endianness::Big => Endian::Big,
+        _ => Endian::Little,
+    };
+    let count = dims
+        .iter()
+        .try_fold(1usize, |n, &d| n.checked_mul(d))
+        .ok_or_else(|| bad("the array is too large".into()))?;
+    let layout = Layout {
+        dtype,
+        endian,
+        count,
+    };
+    let samples =
+        payload::read_samples(reader, layout, progress).map_err(|e| Error::io(path, e))?;
+    Ok(Grid::new(samples, dims, "NumPy"))
+}

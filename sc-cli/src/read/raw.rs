@@ -1,0 +1,49 @@
+//! Headerless sample files, laid out by the command line.
+
+use std::path::Path;
+
+use super::payload::{Encoding, Layout};
+use super::{Block, RawLayout, Start, read_block};
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::volume::Grid;
+
+/// Reads `path` as `layout` says. The file size must match exactly: a raw file has nothing else
+/// to catch wrong `--dims` or `--dtype`, and a size mismatch is almost always one.
+pub fn read(path: &Path, layout: &RawLayout, progress: &Progress) -> Result<Grid> {
+    let [nx, ny, nz] = layout.dims;
+    let count = nx
+        .checked_mul(ny)
+        .and_then(|n| n.checked_mul(nz))
+        .ok_or_else(|| Error::file(path, "--dims overflow"))?;
+    let block_layout = Layout {
+        dtype: layout.dtype,
+        endian: layout.endian,
+        count,
+    };
+    let need = block_layout.bytes().map(|b| b as u64 + layout.header_bytes);
+    let len = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .len();
+    if need != Some(len) {
+        return Err(Error::file(
+            path,
+            format!(
+                "the file has {len} bytes, but --dims {nx},{ny},{nz} of {} with {} header bytes \
+                 needs {}",
+                layout.dtype.name(),
+                layout.header_bytes,
+                need.map_or("more than fits in memory".into(), |n| n.to_string())
+            ),
+        ));
+    }
+    let block = Block {
+        path,
+        start: Start::At(layout.header_bytes),
+        skip_lines: 0,
+        encoding: Encoding::Raw,
+        skip_decoded: 0,
+        layout: block_layout,
+    };
+    Ok(Grid::new(read_block(&block, progress)?, layout.dims, "raw"))
+}

@@ -1,0 +1,192 @@
+//! The report printed after `extract`, as text and as JSON (`--stats-json`).
+
+use std::fmt;
+use std::time::Duration;
+
+use sc_runtime::{Mode, Stats};
+use serde_json::{Value, json};
+
+/// The paper's Table 1 figures for the knotted torus: Marching Cubes, Steps 1–3, Steps 1–4.
+pub const PAPER_KNOT: [u64; 3] = [13_968, 13_968, 10_464];
+
+/// Everything the summary reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary {
+    /// The input as the user named it.
+    pub input: String,
+    /// Its format.
+    pub format: &'static str,
+    /// `[nx, ny, nz]` as meshed (after `--pad`).
+    pub dims: [usize; 3],
+    /// Sample type name.
+    pub dtype: &'static str,
+    /// Surface value.
+    pub iso: f64,
+    /// Which steps ran.
+    pub mode: Mode,
+    /// Counts from the extractor.
+    pub stats: Stats,
+    /// Time spent reading (or generating) the volume.
+    pub read: Duration,
+    /// Time spent extracting.
+    pub extract: Duration,
+    /// Time spent writing the mesh.
+    pub write: Duration,
+    /// For the paper's knot: our triangle count in paper mode, printed beside Table 1's figures.
+    pub paper_knot: Option<u64>,
+}
+
+/// A mode's name in reports.
+pub fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Embedded => "Steps 1–4, embedded",
+        Mode::Paper => "Steps 1–4, paper",
+        Mode::Steps123 => "Steps 1–3",
+    }
+}
+
+/// `n` with thousands separators, as the paper prints counts.
+pub fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Triangles saved against Steps 1–3, in percent.
+pub fn reduction(stats: &Stats) -> f64 {
+    if stats.t13 == 0 {
+        0.0
+    } else {
+        100.0 * (1.0 - stats.triangles as f64 / stats.t13 as f64)
+    }
+}
+
+impl Summary {
+    /// The JSON form: same numbers, seconds as floats.
+    pub fn to_json(&self) -> Value {
+        let s = &self.stats;
+        json!({
+            "input": self.input,
+            "format": self.format,
+            "dims": self.dims,
+            "dtype": self.dtype,
+            "iso": self.iso,
+            "mode": format!("{:?}", self.mode).to_lowercase(),
+            "steps123": { "vertices": s.v13, "triangles": s.t13 },
+            "result": { "vertices": s.vertices, "triangles": s.triangles },
+            "merged": s.merged,
+            "blocked": s.blocked,
+            "reduction_percent": reduction(s),
+            "seconds": {
+                "read": self.read.as_secs_f64(),
+                "extract": self.extract.as_secs_f64(),
+                "write": self.write.as_secs_f64(),
+            },
+        })
+    }
+}
+
+impl fmt::Display for Summary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = &self.stats;
+        let [nx, ny, nz] = self.dims;
+        writeln!(f, "{} ({})", self.input, self.format)?;
+        writeln!(
+            f,
+            "  dims {nx} × {ny} × {nz}, {}, iso {}",
+            self.dtype, self.iso
+        )?;
+        writeln!(f, "  {:<22}{:>12}{:>12}", "", "vertices", "triangles")?;
+        writeln!(
+            f,
+            "  {:<22}{:>12}{:>12}",
+            "Steps 1–3",
+            thousands(s.v13),
+            thousands(s.t13)
+        )?;
+        if self.mode != Mode::Steps123 {
+            writeln!(
+                f,
+                "  {:<22}{:>12}{:>12}   {:.1} % fewer triangles ({} grey edges merged)",
+                mode_name(self.mode),
+                thousands(s.vertices),
+                thousands(s.triangles),
+                reduction(s),
+                thousands(s.merged)
+            )?;
+        }
+        if let Some(ours) = self.paper_knot {
+            let [mc, t13, t14] = PAPER_KNOT.map(thousands);
+            writeln!(
+                f,
+                "  paper, Table 1 (knot): Marching Cubes {mc}, Steps 1–3 {t13}, Steps 1–4 {t14} triangles"
+            )?;
+            writeln!(
+                f,
+                "  ours:                  Steps 1–3 {}, Steps 1–4 (paper mode) {} triangles",
+                thousands(s.t13),
+                thousands(ours)
+            )?;
+        }
+        write!(
+            f,
+            "  time: read {:.3} s, extract {:.3} s, write {:.3} s",
+            self.read.as_secs_f64(),
+            self.extract.as_secs_f64(),
+            self.write.as_secs_f64()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thousands_groups_digits() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(13_968), "13,968");
+        assert_eq!(thousands(1_234_567), "1,234,567");
+    }
+
+    #[test]
+    fn text_and_json_agree() {
+        let stats = Stats {
+            v13: 10,
+            t13: 16,
+            merged: 2,
+            blocked: 0,
+            vertices: 8,
+            triangles: 12,
+        };
+        let s = Summary {
+            input: "v.nii".into(),
+            format: "NIfTI-1",
+            dims: [4, 5, 6],
+            dtype: "u8",
+            iso: 20.0,
+            mode: Mode::Embedded,
+            stats,
+            read: Duration::from_millis(5),
+            extract: Duration::from_millis(7),
+            write: Duration::from_millis(1),
+            paper_knot: None,
+        };
+        let text = s.to_string();
+        assert!(
+            text.contains("4 × 5 × 6") && text.contains("25.0 % fewer"),
+            "{text}"
+        );
+        let j = s.to_json();
+        assert_eq!(j["result"]["triangles"], 12);
+        assert_eq!(j["mode"], "embedded");
+        assert_eq!(j["reduction_percent"], 25.0);
+    }
+}

