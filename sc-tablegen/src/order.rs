@@ -8,7 +8,7 @@ pub const GREYS0: [u8; 3] = [8, 3, 5];
 
 /// The nine non-grey edges of class 0, in the order chosen by measurement (see the README's
 /// "Nibbling order" section and `sc-tablegen optimize-order`).
-pub const ORDER0: [u8; 9] = [0, 1, 2, 4, 6, 7, 9, 10, 11];
+pub const ORDER0: [u8; 9] = [1, 7, 4, 11, 9, 6, 2, 0, 10];
 
 /// Class 0's full 12-edge order: greys first, then `nine`.
 pub fn full_order(nine: &[u8; 9]) -> [u8; 12] {
