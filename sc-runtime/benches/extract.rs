@@ -6,6 +6,7 @@
 //! skipped with a notice. `bench/compare.py` runs these and VTK's FlyingEdges in one go.
 
 use std::path::Path;
+use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use sc_runtime::{Mode, Params, Scalar, Volume, demo, extract_par};
@@ -16,7 +17,7 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
     let vol = Volume::new(data, dims).expect("bench volumes are consistent");
     let all = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut group = c.benchmark_group(name);
-    group.sample_size(10);
+    group.sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3));
     for (mode, mode_name) in MODES {
         let params = Params { mode, normals: false, ..Params::new(iso) };
         for threads in [1, all] {
