@@ -126,6 +126,10 @@ pub struct ExtractArgs {
     /// Write text PLY instead of binary.
     #[arg(long)]
     pub ascii: bool,
+    /// Report how the mesh's edges are shared: border, manifold (two triangles), non-manifold
+    /// (more), and misoriented.
+    #[arg(long)]
+    pub check: bool,
     /// How to read the volume.
     #[command(flatten)]
     pub read: InputArgs,

@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod builtin;
+pub mod check;
 pub mod cli;
 pub mod cmd;
 pub mod error;

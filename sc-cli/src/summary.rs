@@ -6,6 +6,8 @@ use std::time::Duration;
 use sc_runtime::{Mode, Stats};
 use serde_json::{Value, json};
 
+use crate::check::EdgeReport;
+
 /// The paper's Table 1 figures for the knotted torus: Marching Cubes, Steps 1–3, Steps 1–4.
 pub const PAPER_KNOT: [u64; 3] = [13_968, 13_968, 10_464];
 
@@ -34,6 +36,8 @@ pub struct Summary {
     pub write: Duration,
     /// For the paper's knot: our triangle count in paper mode, printed beside Table 1's figures.
     pub paper_knot: Option<u64>,
+    /// With `--check`: how the mesh's edges are shared.
+    pub edges: Option<EdgeReport>,
 }
 
 /// A mode's name in reports.
@@ -71,7 +75,7 @@ impl Summary {
     /// The JSON form: same numbers, seconds as floats.
     pub fn to_json(&self) -> Value {
         let s = &self.stats;
-        json!({
+        let mut j = json!({
             "input": self.input,
             "format": self.format,
             "dims": self.dims,
@@ -88,7 +92,11 @@ impl Summary {
                 "extract": self.extract.as_secs_f64(),
                 "write": self.write.as_secs_f64(),
             },
-        })
+        });
+        if let Some(e) = self.edges {
+            j["edges"] = e.to_json();
+        }
+        j
     }
 }
 
@@ -132,6 +140,16 @@ impl fmt::Display for Summary {
                 "  ours:                  Steps 1–3 {}, Steps 1–4 (paper mode) {} triangles",
                 thousands(s.t13),
                 thousands(ours)
+            )?;
+        }
+        if let Some(e) = self.edges {
+            writeln!(
+                f,
+                "  edges: {} in 2 triangles, {} in 1 (border), {} in 3 or more, {} misoriented",
+                thousands(e.manifold),
+                thousands(e.border),
+                thousands(e.non_manifold),
+                thousands(e.misoriented)
             )?;
         }
         write!(
@@ -178,6 +196,7 @@ mod tests {
             extract: Duration::from_millis(7),
             write: Duration::from_millis(1),
             paper_knot: None,
+            edges: None,
         };
         let text = s.to_string();
         assert!(

@@ -496,3 +496,40 @@ fn usage_errors_exit_2_before_reading() {
         "missing.nii: no such file",
     );
 }
+
+/// `--check` reports edge sharing: on a rough closed surface, embedded mode is a 2-manifold
+/// with consistent winding, while paper mode leaves edges shared by four triangles (SPEC §5).
+#[test]
+fn check_reports_paper_mode_non_manifold_edges() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = |mode: &str| {
+        let json = dir.path().join(format!("{mode}.json"));
+        skelclimb()
+            .args([
+                "extract",
+                "--demo",
+                "sphere-noise",
+                "--size",
+                "48",
+                "--mode",
+                mode,
+                "--check",
+                "-q",
+            ])
+            .arg("--stats-json")
+            .arg(&json)
+            .arg("-o")
+            .arg(dir.path().join(format!("{mode}.ply")))
+            .assert()
+            .success();
+        let j: serde_json::Value = serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap();
+        j["edges"].clone()
+    };
+    let embedded = report("embedded");
+    assert_eq!(embedded["non_manifold_edges"], 0);
+    assert_eq!(embedded["misoriented_edges"], 0);
+    assert_eq!(embedded["border_edges"], 0);
+    assert!(embedded["manifold_edges"].as_u64().unwrap() > 1000);
+    let paper = report("paper");
+    assert!(paper["non_manifold_edges"].as_u64().unwrap() > 0, "{paper}");
+}

@@ -8,6 +8,7 @@ use sc_runtime::{Mesh, Mode};
 use super::warn;
 use crate::atomic::AtomicFile;
 use crate::builtin;
+use crate::check::EdgeReport;
 use crate::cli::{Demo, ExtractArgs, ModeArg};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -128,6 +129,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         extract: extract_time,
         write: clock.elapsed(),
         paper_knot,
+        edges: args.check.then(|| EdgeReport::of(&mesh.triangles)),
     };
     if let Some(file) = stats_file {
         let json = serde_json::to_vec_pretty(&summary.to_json()).map_err(std::io::Error::other);
