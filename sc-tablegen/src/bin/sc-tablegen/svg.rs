@@ -31,9 +31,9 @@ pub fn picture(set: &TableSet, p: u8, case: u8) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="260" height="250" viewBox="0 0 260 250" font-family="sans-serif" font-size="11">"#
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="300" height="250" viewBox="0 0 300 250" font-family="sans-serif" font-size="11">"#
     );
-    let _ = write!(s, r#"<rect width="260" height="250" fill="white"/>"#);
+    let _ = write!(s, r#"<rect width="300" height="250" fill="white"/>"#);
     let blocked: Vec<u8> = entry
         .grey
         .iter()
