@@ -581,21 +581,4 @@ mod tests {
             .collect();
         assert_eq!(found, expected);
     }
-
-    /// Timing on a 2·10⁶-triangle torus; run with
-    /// `cargo test -p sc-tests --release -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn large_torus_timing() {
-        let (p, t) = torus(1000, 1000);
-        let start = Instant::now();
-        let found = self_intersections(&p, &t);
-        println!(
-            "{} triangles: {:?}, {} found",
-            t.len(),
-            start.elapsed(),
-            found.len()
-        );
-        assert_eq!(found, vec![]);
-    }
 }
