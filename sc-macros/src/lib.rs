@@ -102,12 +102,20 @@ fn expand(input: &Input) -> Result<Tokens, String> {
         });
     let embedded: Vec<Tokens> = embedded.collect();
     let paper: Vec<Tokens> = paper.collect();
+    // One byte per entry, so the merge decision reads 2 KiB rather than the whole table.
+    let mergeable = set.classes.iter().flat_map(|c| &c.cases).map(|e| {
+        e.grey
+            .iter()
+            .filter(|g| g.mergeable)
+            .fold(0u8, |m, g| m | 1 << (g.edge / 4))
+    });
     Ok(quote! {{
         // Makes the compiler rebuild this crate when the tables file changes.
         const _: &[u8] = include_bytes!(#shown);
         static EMBEDDED: [::sc_runtime::tables::Entry; 2048] = [#(#embedded),*];
         static PAPER: [::sc_runtime::tables::Entry; 2048] = [#(#paper),*];
-        ::sc_runtime::tables::CaseTables::from_static(&EMBEDDED, &PAPER)
+        static MERGEABLE: [u8; 2048] = [#(#mergeable),*];
+        ::sc_runtime::tables::CaseTables::from_static(&EMBEDDED, &PAPER, &MERGEABLE)
     }})
 }
 

@@ -27,6 +27,21 @@ impl Sink for Mesh {
     fn triangle(&mut self, triangle: [u32; 3]) {
         self.triangles.push(triangle);
     }
+
+    fn expect(&mut self, vertices: usize, triangles: usize) {
+        // Reserve with a quarter to spare, and only when the hint outgrows the capacity, so the
+        // buffers are reallocated a few times at most and never doubled past need.
+        fn grow<T>(v: &mut Vec<T>, more: usize) {
+            if v.capacity() - v.len() < more {
+                v.reserve_exact(more + more / 4);
+            }
+        }
+        grow(&mut self.positions, vertices);
+        if !self.normals.is_empty() {
+            grow(&mut self.normals, vertices);
+        }
+        grow(&mut self.triangles, triangles);
+    }
 }
 
 /// Scratch buffers owned on the heap.

@@ -41,6 +41,12 @@ pub fn extract_par<T: Scalar>(
     if !has_cubes(dims) {
         return Ok(Mesh::default());
     }
+    if threads == 1 {
+        // No pool, no chunks, no stitching copy.
+        let mesh = crate::extract(volume, params)?;
+        progress(dims[2] - 1);
+        return Ok(mesh);
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

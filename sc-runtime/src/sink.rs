@@ -6,4 +6,10 @@ pub trait Sink {
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>);
     /// A triangle, wound so that `(b − a) × (c − a)` points from filled to empty.
     fn triangle(&mut self, triangle: [u32; 3]);
+    /// A hint, after each layer: about this many more vertices and triangles are to come
+    /// (extrapolated from the layers so far). A sink that allocates can reserve once instead of
+    /// growing by doubling; the default ignores it.
+    fn expect(&mut self, vertices: usize, triangles: usize) {
+        let _ = (vertices, triangles);
+    }
 }

@@ -41,6 +41,8 @@ struct Grid<'s> {
     dims: [usize; 3],
     mode: Mode,
     entries: &'static [Entry; 2048],
+    /// Per entry, bit `axis` set iff that grey edge may merge (embedded table).
+    mergeable: &'static [u8; 2048],
     /// Four slices of 0/1 bytes, slice `z` at `z % 4`.
     filled: &'s mut [u8],
     /// Three layers of cube cases, layer `k` at `k % 3`, row stride `nx`.
@@ -65,6 +67,8 @@ pub(crate) struct Sweep<'s, T: Scalar> {
     out: Out<'s>,
     params: Params,
     threshold: T::Threshold,
+    /// The layer `start` prepared: where this sweep's output began.
+    first_layer: usize,
 }
 
 impl<'s, T: Scalar> Sweep<'s, T> {
@@ -77,6 +81,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 dims,
                 mode: params.mode,
                 entries: params.tables.for_mode(params.mode),
+                mergeable: params.tables.mergeable(),
                 filled,
                 cases: &mut rest[..3 * nxy],
                 spans,
@@ -89,6 +94,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             },
             params: *params,
             threshold: T::threshold(params.iso),
+            first_layer: 0,
         }
     }
 
@@ -119,6 +125,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             self.grid.compute_cases(z0 - 1);
         }
         self.grid.compute_cases(z0);
+        self.first_layer = z0;
         self.out.emit = emit_plane;
         let r = self.plane_vertices(z0, src, sink);
         self.out.emit = true;
@@ -140,6 +147,13 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         self.z_vertices(k, src, sink)?;
         self.plane_vertices(k + 1, src, sink)?;
         self.triangles(k, sink);
+        if self.out.emit {
+            // Layers done since this sweep started, and the ones left, extrapolate the output.
+            let done = (k + 1 - self.first_layer) as u64;
+            let left = (self.grid.dims[2] - 2 - k) as u64;
+            let per = |n: u64| usize::try_from(n * left / done).unwrap_or(usize::MAX);
+            sink.expect(per(self.out.stats.vertices), per(self.out.stats.triangles));
+        }
         Ok(())
     }
 
@@ -174,22 +188,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let row = grid.row(n, y);
             let (lo, hi) = grid.span(grid.slice_row(n, y));
             let x_grey = y % 2 == 1 && n % 2 == 1;
-            for x in lo..hi {
-                if row[x] != row[x + 1] {
-                    let id = out.edge_vertex(grid, params, [x, y, n], 0, x_grey, &field, sink)?;
-                    out.ids[xbase + y * nx + x] = id;
-                }
-            }
+            for_each_differing(row, &row[1..], lo, hi, |x| {
+                let id = out.edge_vertex(grid, params, [x, y, n], 0, x_grey, &field, sink)?;
+                out.ids[xbase + y * nx + x] = id;
+                Ok(())
+            })?;
             if y + 1 < ny {
                 let next = grid.row(n, y + 1);
                 let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
-                for x in start..end {
-                    if row[x] != next[x] {
-                        let grey = x % 2 == 1 && n % 2 == 0;
-                        let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
-                        out.ids[ybase + y * nx + x] = id;
-                    }
-                }
+                for_each_differing(row, next, start, end, |x| {
+                    let grey = x % 2 == 1 && n % 2 == 0;
+                    let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
+                    out.ids[ybase + y * nx + x] = id;
+                    Ok(())
+                })?;
             }
         }
         Ok(())
@@ -209,13 +221,12 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         for y in 0..ny {
             let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
             let (start, end) = grid.union_span(&[(y, k), (y, k + 1)]);
-            for x in start..end {
-                if below[x] != above[x] {
-                    let grey = x % 2 == 0 && y % 2 == 0;
-                    let id = out.edge_vertex(grid, params, [x, y, k], 2, grey, &field, sink)?;
-                    out.ids[zbase + y * nx + x] = id;
-                }
-            }
+            for_each_differing(below, above, start, end, |x| {
+                let grey = x % 2 == 0 && y % 2 == 0;
+                let id = out.edge_vertex(grid, params, [x, y, k], 2, grey, &field, sink)?;
+                out.ids[zbase + y * nx + x] = id;
+                Ok(())
+            })?;
         }
         Ok(())
     }
@@ -235,6 +246,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 _ => 4 * nxy + a + b * nx,
             }
         });
+        // Where each class's three grey-edge ids live, relative to the cube's `i + nx * j`.
+        let grey_at: [[usize; 3]; 8] = GREYS.map(|g| g.map(|e| edge_at[usize::from(e)]));
         let grid = &self.grid;
         let ids = &*self.out.ids;
         let stats = &mut self.out.stats;
@@ -253,28 +266,70 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 stats.t13 += u64::from(entry.count);
                 let at = i + nx * j;
                 let id = |e: u8| ids[edge_at[usize::from(e)] + at];
-                // Per triangle: emit as is, skip (a merged ear), or emit the merged pair's
-                // triangle instead (the ear of the pair's owner).
-                let mut replace: [Option<Option<[u32; 3]>>; 5] = [None; 5];
+                // A merged grey edge's ear is dropped; the pair's owner emits the merged
+                // triangle in its place (its partner emits nothing). Masks rather than branches:
+                // which greys merged is data, and data-dependent branches mispredict.
+                let (mut merged, mut dropped) = (0u8, 0u8);
                 if merging {
-                    for axis in 0..3 {
+                    for (axis, &grey) in grey_at[class].iter().enumerate() {
                         let ear = entry.ears[axis];
-                        if ear != NO_EAR && id(grey_edge(class as u8, axis)) == MERGED {
-                            replace[usize::from(ear)] =
-                                Some(grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at));
-                        }
+                        // A grey without an ear reads a stale id here, but cannot count.
+                        let m = u8::from((ear != NO_EAR) & (ids[grey + at] == MERGED));
+                        merged |= m << axis;
+                        dropped |= m << (ear & 7);
+                    }
+                    let mut owned = merged & OWNS[class];
+                    while owned != 0 {
+                        let axis = owned.trailing_zeros() as usize;
+                        owned &= owned - 1;
+                        stats.triangles += 1;
+                        sink.triangle(grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at));
                     }
                 }
-                for (t, r) in entry.tris[..usize::from(entry.count)].iter().zip(replace) {
-                    if let Some(tri) = r.unwrap_or_else(|| Some(t.map(id))) {
-                        stats.triangles += 1;
-                        sink.triangle(tri);
-                    }
+                let mut kept = ((1u16 << entry.count) - 1) as u8 & !dropped;
+                while kept != 0 {
+                    let n = kept.trailing_zeros() as usize;
+                    kept &= kept - 1;
+                    stats.triangles += 1;
+                    sink.triangle(entry.tris[n].map(id));
                 }
             }
         }
     }
 }
+
+/// Per class, bit `axis` set iff a cube of the class owns the merged pair of that grey edge: it
+/// emits the pair's triangle, its partner (the neighbour across the pair's shared face) does not.
+/// x-greys pair with the y-neighbour and y-greys with the x-neighbour, so the diagonal is
+/// horizontal; z-greys pair along y in even layers and along x in odd ones, so the quads above and
+/// below a sample choose different diagonals. The owner is the lower cube of the pair.
+const OWNS: [u8; 8] = {
+    let mut owns = [0u8; 8];
+    let mut p = 0;
+    while p < 8 {
+        let (a, b, c) = (p & 1, (p >> 1) & 1, (p >> 2) & 1);
+        // The grey edge lies on the high side of the cube along the pairing axis.
+        let z_owner = if c == 0 { b == 1 } else { a == 1 };
+        owns[p] = (b == 0) as u8 | ((a == 0) as u8) << 1 | (z_owner as u8) << 2;
+        p += 1;
+    }
+    owns
+};
+
+/// Each class's grey edges by axis, so the triangle loop need not recompute them per cube.
+const GREYS: [[u8; 3]; 8] = {
+    let mut g = [[0u8; 3]; 8];
+    let mut p = 0;
+    while p < 8 {
+        g[p] = [
+            grey_edge(p as u8, 0),
+            grey_edge(p as u8, 1),
+            grey_edge(p as u8, 2),
+        ];
+        p += 1;
+    }
+    g
+};
 
 impl Out<'_> {
     /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number.
@@ -461,8 +516,7 @@ impl Grid<'_> {
         }
         let mergeable = cubes.iter().all(|&(i, j, k)| {
             let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
-            self.entries[class * 256 + usize::from(self.case_at(i, j, k))].mergeable >> axis & 1
-                == 1
+            self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis & 1 == 1
         });
         if mergeable && !self.pinch(p, axis) {
             Decision::Merge
@@ -520,8 +574,9 @@ impl Grid<'_> {
         true
     }
 
-    /// For a merged grey edge: the triangle that replaces this cube's ear and its partner's, if
-    /// this cube is the pair's owner (the partner then emits nothing for its ear).
+    /// For a merged grey edge owned by this cube (see [`OWNS`]): the triangle that replaces its
+    /// ear and its partner's.
+    #[inline(always)]
     fn merged_triangle(
         &self,
         ids: &[u32],
@@ -529,40 +584,57 @@ impl Grid<'_> {
         axis: usize,
         entry: &Entry,
         edge_at: &[usize; 12],
-    ) -> Option<[u32; 3]> {
-        let (a, b) = (i & 1, j & 1);
-        // x-greys pair with the y-neighbour and y-greys with the x-neighbour, so the diagonal is
-        // horizontal; z-greys alternate by layer so the quads above and below a sample choose
-        // different diagonals.
-        let along_y = match axis {
-            0 => true,
-            1 => false,
-            _ => k % 2 == 0,
-        };
-        let owner = match axis {
-            0 => b == 0,
-            1 => a == 0,
-            _ if along_y => b == 1,
-            _ => a == 1,
-        };
-        if !owner {
-            return None;
-        }
+    ) -> [u32; 3] {
+        let along_y = axis == 0 || (axis == 2 && k % 2 == 0);
         let (pi, pj) = if along_y { (i, j + 1) } else { (i + 1, j) };
         let nx = self.dims[0];
         let pclass = (pi & 1) | (pj & 1) << 1 | (k & 1) << 2;
         let pentry = &self.entries[pclass * 256 + usize::from(self.case_at(pi, pj, k))];
-        let ear = |e: &Entry, at: usize| {
-            e.tris[usize::from(e.ears[axis])].map(|x| ids[edge_at[usize::from(x)] + at])
+        // An ear is stored `[back, grey, forward]`: only its two outer vertices matter.
+        let outer = |e: &Entry, at: usize| {
+            let [b, _, f] = e.tris[usize::from(e.ears[axis])];
+            (
+                ids[edge_at[usize::from(b)] + at],
+                ids[edge_at[usize::from(f)] + at],
+            )
         };
-        let [ba, _, fa] = ear(entry, i + nx * j);
-        let [bb, _, fb] = ear(pentry, pi + nx * pj);
+        let (ba, fa) = outer(entry, i + nx * j);
+        let (bb, fb) = outer(pentry, pi + nx * pj);
         debug_assert!(
             ba == fb || bb == fa,
             "ears around a merged grey edge share a face side"
         );
-        Some(if ba == fb { [fa, ba, bb] } else { [fb, fa, ba] })
+        if ba == fb { [fa, ba, bb] } else { [fb, fa, ba] }
     }
+}
+
+/// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing eight
+/// bytes at a time: most of a row's span is unchanged, and a vertex is the rare event.
+#[inline]
+fn for_each_differing(
+    a: &[u8],
+    b: &[u8],
+    start: usize,
+    end: usize,
+    mut f: impl FnMut(usize) -> Result<(), Error>,
+) -> Result<(), Error> {
+    let mut x = start;
+    while x + 8 <= end {
+        let word = |r: &[u8]| u64::from_le_bytes(r[x..x + 8].try_into().expect("eight bytes"));
+        let mut diff = word(a) ^ word(b);
+        while diff != 0 {
+            let byte = diff.trailing_zeros() as usize / 8;
+            f(x + byte)?;
+            diff &= !(0xFF << (8 * byte));
+        }
+        x += 8;
+    }
+    for x in x..end {
+        if a[x] != b[x] {
+            f(x)?;
+        }
+    }
+    Ok(())
 }
 
 /// The first index whose byte differs from `v`, comparing 16 bytes at a time.

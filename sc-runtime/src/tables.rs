@@ -27,6 +27,7 @@ pub struct Entry {
 pub struct CaseTables {
     embedded: &'static [Entry; 2048],
     paper: &'static [Entry; 2048],
+    mergeable: &'static [u8; 2048],
 }
 
 impl CaseTables {
@@ -35,8 +36,19 @@ impl CaseTables {
     pub const fn from_static(
         embedded: &'static [Entry; 2048],
         paper: &'static [Entry; 2048],
+        mergeable: &'static [u8; 2048],
     ) -> Self {
-        CaseTables { embedded, paper }
+        CaseTables {
+            embedded,
+            paper,
+            mergeable,
+        }
+    }
+
+    /// The embedded table's [`Entry::mergeable`] bits alone, compact for the merge decision.
+    #[inline]
+    pub fn mergeable(&self) -> &'static [u8; 2048] {
+        self.mergeable
     }
 
     /// The table a mode reads.
