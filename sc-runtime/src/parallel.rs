@@ -1,3 +1,4 @@
+use std::vec;
 use std::vec::Vec;
 
 use rayon::prelude::*;
@@ -62,55 +63,79 @@ pub fn extract_par<T: Scalar>(
         data: volume.data(),
         nxy: dims[0] * dims[1],
     };
-    let parts: Vec<Result<Part, Error>> = pool.install(|| {
-        bounds
+    pool.install(|| {
+        let parts: Vec<Result<Part, Error>> = bounds
             .par_iter()
-            .map(|&(z0, z1)| {
-                let mut scratch = OwnedScratch::new(dims)?;
-                let mut mesh = Mesh::default();
-                let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
-                sweep.start(z0, &src, &mut mesh, z0 == 0)?;
-                let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
-                for k in z0..z1 {
-                    sweep.layer(k, &src, &mut mesh)?;
-                    progress(1);
-                }
-                mesh.stats = sweep.stats();
-                Ok(Part { mesh, first_plane })
-            })
-            .collect()
-    });
-    stitch(parts.into_iter().collect::<Result<Vec<_>, _>>()?)
+            // Scratch is reused by the chunks one worker runs, rather than faulted in per chunk.
+            .map_init(
+                || OwnedScratch::new(dims),
+                |scratch, &(z0, z1)| {
+                    let scratch = scratch.as_mut().map_err(|e| e.clone())?;
+                    let mut mesh = Mesh::default();
+                    let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
+                    sweep.start(z0, &src, &mut mesh, z0 == 0)?;
+                    let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
+                    for k in z0..z1 {
+                        sweep.layer(k, &src, &mut mesh)?;
+                        progress(1);
+                    }
+                    mesh.stats = sweep.stats();
+                    Ok(Part { mesh, first_plane })
+                },
+            )
+            .collect();
+        stitch(parts.into_iter().collect::<Result<Vec<_>, _>>()?)
+    })
 }
 
-/// Concatenates chunk meshes, shifting each chunk's ids by its start in the global order.
+/// Concatenates chunk meshes, shifting each chunk's ids by its start in the global order. The
+/// output is allocated zeroed (pages the kernel provides lazily) and filled in parallel.
 fn stitch(parts: Vec<Part>) -> Result<Mesh, Error> {
-    let mut out = Mesh::default();
     let total_v: usize = parts.iter().map(|p| p.mesh.positions.len()).sum();
+    let total_n: usize = parts.iter().map(|p| p.mesh.normals.len()).sum();
     let total_t: usize = parts.iter().map(|p| p.mesh.triangles.len()).sum();
     if u32::try_from(total_v).is_err() {
         return Err(Error::TooManyVertices);
     }
-    out.positions.reserve_exact(total_v);
-    out.normals
-        .reserve_exact(parts.iter().map(|p| p.mesh.normals.len()).sum());
-    out.triangles.reserve_exact(total_t);
-    let mut stats = Stats::default();
-    for part in parts {
-        // This chunk's id `first_plane` is the first vertex it emitted.
-        let shift = out.positions.len() as u32 - part.first_plane;
-        out.positions.extend_from_slice(&part.mesh.positions);
-        out.normals.extend_from_slice(&part.mesh.normals);
-        out.triangles
-            .extend(part.mesh.triangles.iter().map(|t| t.map(|i| i + shift)));
-        let s = part.mesh.stats;
-        stats.v13 += s.v13;
-        stats.t13 += s.t13;
-        stats.merged += s.merged;
-        stats.blocked += s.blocked;
-        stats.vertices += s.vertices;
-        stats.triangles += s.triangles;
+    let mut out = Mesh {
+        positions: vec![[0.0; 3]; total_v],
+        normals: vec![[0.0; 3]; total_n],
+        triangles: vec![[0; 3]; total_t],
+        stats: Stats::default(),
+    };
+    // Each chunk's destination slices, and the shift that makes its ids global: its id
+    // `first_plane` is the first vertex it emitted.
+    let mut jobs = Vec::with_capacity(parts.len());
+    let (mut pos, mut nor, mut tri) = (
+        &mut out.positions[..],
+        &mut out.normals[..],
+        &mut out.triangles[..],
+    );
+    let mut emitted = 0u32;
+    for part in &parts {
+        let m = &part.mesh;
+        let (p, rest_p) = core::mem::take(&mut pos).split_at_mut(m.positions.len());
+        let (n, rest_n) = core::mem::take(&mut nor).split_at_mut(m.normals.len());
+        let (t, rest_t) = core::mem::take(&mut tri).split_at_mut(m.triangles.len());
+        (pos, nor, tri) = (rest_p, rest_n, rest_t);
+        jobs.push((part, p, n, t, emitted - part.first_plane));
+        emitted += m.positions.len() as u32;
     }
-    out.stats = stats;
+    jobs.into_par_iter().for_each(|(part, p, n, t, shift)| {
+        p.copy_from_slice(&part.mesh.positions);
+        n.copy_from_slice(&part.mesh.normals);
+        for (d, s) in t.iter_mut().zip(&part.mesh.triangles) {
+            *d = s.map(|i| i + shift);
+        }
+    });
+    for part in &parts {
+        let s = part.mesh.stats;
+        out.stats.v13 += s.v13;
+        out.stats.t13 += s.t13;
+        out.stats.merged += s.merged;
+        out.stats.blocked += s.blocked;
+        out.stats.vertices += s.vertices;
+        out.stats.triangles += s.triangles;
+    }
     Ok(out)
 }
