@@ -77,20 +77,23 @@ impl AtomicFile {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let temp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".tmp")
-            .tempfile_in(dir)
-            .map_err(|e| {
-                Error::file(
-                    target,
-                    format!(
-                        "cannot create a file in {}: {}",
-                        dir.display(),
-                        io_reason(&e)
-                    ),
-                )
-            })?;
+        let prefix = format!(".{name}.");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        // A temporary file is private (0600) by default, and the rename would keep that: ask for
+        // 0666 so the umask gives the output the mode any newly created file gets.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let temp = builder.tempfile_in(dir).map_err(|e| {
+            Error::file(
+                target,
+                format!(
+                    "cannot create a file in {}: {}",
+                    dir.display(),
+                    io_reason(&e)
+                ),
+            )
+        })?;
         let pending = Pending::new(temp.path());
         Ok(AtomicFile {
             temp,
@@ -128,6 +131,23 @@ fn io_reason(e: &io::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The output gets the permissions of any new file (the umask's), not a temporary file's 0600.
+    #[cfg(unix)]
+    #[test]
+    fn output_has_ordinary_file_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("mesh.ply");
+        AtomicFile::create(&target)
+            .unwrap()
+            .write_with(|out| out.write_all(b"ply"))
+            .unwrap();
+        let plain = dir.path().join("plain");
+        File::create(&plain).unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&target), mode(&plain));
+    }
 
     fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
