@@ -108,10 +108,16 @@ fn build_entry(nine: &[u8; 9], p: u8, case: u8) -> Result<Entry, String> {
         .chain(orders_keeping(class_order(nine, p, Rule::Base), 3).map(|o| (Rule::Fallback, o)))
         .map(|(rule, order)| (rule, nibble(&loops, &order)))
         .find(|(_, n)| {
-            n.folds().iter().all(|f| forced_ear_fold(&loops, &forced, f))
+            n.folds()
+                .iter()
+                .all(|f| forced_ear_fold(&loops, &forced, f))
                 && embed::check(&n.triangles, seed).is_ok()
         })
-        .map(|(rule, n)| PaperEntry { grey: grey_records(&loops, &n, p, &forced), triangles: n.triangles, rule })
+        .map(|(rule, n)| PaperEntry {
+            grey: grey_records(&loops, &n, p, &forced),
+            triangles: n.triangles,
+            rule,
+        })
         .ok_or("no greys-first order keeps only the forced fold and stays embedded")?;
     Ok(Entry {
         case,
