@@ -19,7 +19,12 @@ pub enum Error {
     ScratchTooSmall,
     /// The worker threads could not be started.
     ThreadPool,
-    /// A streamed slice does not hold `nx · ny` values, or more than `nz` slices were pushed.
+    /// More than `nz` slices were pushed into a streamer.
+    TooManySlices {
+        /// `nz`, the number of slices the streamer was made for.
+        nz: usize,
+    },
+    /// A streamed slice does not hold `nx · ny` values.
     SliceLength {
         /// `nx · ny`.
         expected: usize,
@@ -48,6 +53,7 @@ impl fmt::Display for Error {
                 f.write_str("scratch buffers are too small for these dimensions")
             }
             Error::ThreadPool => f.write_str("could not start the worker threads"),
+            Error::TooManySlices { nz } => write!(f, "more than the {nz} slices the volume has"),
             Error::SliceLength { expected, actual } => {
                 write!(f, "expected a slice of {expected} samples, got {actual}")
             }

@@ -70,7 +70,10 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
     /// Takes the next z-slice (`nx · ny` samples, x fastest) and finishes every layer it completes.
     pub fn push(&mut self, slice: &[T]) -> Result<(), Error> {
         let nxy = self.ring.nxy;
-        if slice.len() != nxy || self.received >= self.dims[2] {
+        if self.received >= self.dims[2] {
+            return Err(Error::TooManySlices { nz: self.dims[2] });
+        }
+        if slice.len() != nxy {
             return Err(Error::SliceLength {
                 expected: nxy,
                 actual: slice.len(),

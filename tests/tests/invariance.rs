@@ -136,7 +136,11 @@ fn bad_input_is_an_error_not_a_panic() {
     for _ in 0..2 {
         s.push(&[0.0; 16]).expect("slices 1, 2");
     }
-    assert!(s.push(&[0.0; 16]).is_err(), "a fourth slice of three");
+    assert_eq!(
+        s.push(&[0.0; 16]),
+        Err(Error::TooManySlices { nz: 3 }),
+        "a fourth slice of three"
+    );
     let (mesh, stats) = s.finish().expect("finish");
     assert_eq!(mesh.triangles.len() as u64, stats.triangles);
     let (mut b, mut w) = (vec![0u8; len.bytes], vec![0u32; len.words]);
