@@ -22,7 +22,7 @@ macro_rules! int_scalar {
             #[inline]
             fn threshold(iso: f64) -> Option<$t> {
                 // `v >= iso` is `v >= ceil(iso)` for integers; NaN fills nothing.
-                let c = if iso.is_nan() { i64::MAX } else { libm_ceil(iso) };
+                let c = if iso.is_nan() { i64::MAX } else { ceil_saturating(iso) };
                 if c > <$t>::MAX as i64 { None } else { Some(c.max(<$t>::MIN as i64) as $t) }
             }
             #[inline]
@@ -73,7 +73,7 @@ impl Scalar for f64 {
 }
 
 /// `ceil` saturated to `i64`, without `std`: the `as` cast truncates toward zero and saturates.
-fn libm_ceil(x: f64) -> i64 {
+fn ceil_saturating(x: f64) -> i64 {
     let t = x as i64;
     if (t as f64) < x {
         t.saturating_add(1)

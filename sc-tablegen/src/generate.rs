@@ -194,7 +194,7 @@ fn forced_ear_fold(loops: &Loops, forced: &[u8], fold: &crate::nibble::Fold) -> 
 
 /// Records of the class's occupied greys, x, y, z: the ear if the vertex has exactly one triangle
 /// whose two sides there are face sides, and mergeability (not for forced folds).
-pub fn grey_records(loops: &Loops, n: &Nibbled, p: u8, forced: &[u8]) -> Vec<Grey> {
+fn grey_records(loops: &Loops, n: &Nibbled, p: u8, forced: &[u8]) -> Vec<Grey> {
     greys(p)
         .into_iter()
         .filter(|&g| loops.next(g).is_some())

@@ -22,7 +22,7 @@ pub mod sides;
 pub mod table;
 pub mod validate;
 
-pub use generate::{build, generate, grey_records};
+pub use generate::{build, generate};
 pub use order::ORDER0;
 pub use table::{ClassTable, Entry, Grey, PaperEntry, Rule, TableSet};
 pub use validate::{Invalid, validate};

@@ -294,11 +294,6 @@ fn check_greys(
     Ok(())
 }
 
-/// Corner ids as a readable list, for messages and dumps.
-pub fn corner_list(case: u8) -> Vec<u8> {
-    (0..8).filter(|&c| filled(case, c)).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

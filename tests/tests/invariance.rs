@@ -121,40 +121,24 @@ fn bad_input_is_an_error_not_a_panic() {
     let dims = [4, 4, 3];
     let len = Scratch::len(dims).expect("len");
     let params = Params::new(0.5);
-    let (mut b, mut w) = (vec![0u8; len.bytes], vec![0u32; len.words]);
-    let mut ring = vec![0f32; SliceStreamer::<f32, Mesh>::ring_len(dims)];
-    let mut s = SliceStreamer::new(
-        dims,
-        &params,
-        Scratch::new(&mut b, &mut w, dims).expect("scratch"),
-        &mut ring,
-        Mesh::default(),
-    )
-    .expect("streamer");
-    assert!(matches!(s.push(&[0.0; 15]), Err(Error::SliceLength { .. })));
-    s.push(&[1.0; 16]).expect("slice 0");
-    for _ in 0..2 {
-        s.push(&[0.0; 16]).expect("slices 1, 2");
-    }
-    assert_eq!(
-        s.push(&[0.0; 16]),
-        Err(Error::TooManySlices { nz: 3 }),
-        "a fourth slice of three"
-    );
-    let (mesh, stats) = s.finish().expect("finish");
-    assert_eq!(mesh.triangles.len() as u64, stats.triangles);
-    let (mut b, mut w) = (vec![0u8; len.bytes], vec![0u32; len.words]);
-    let mut ring = vec![0f32; SliceStreamer::<f32, Mesh>::ring_len(dims)];
-    let mut s = SliceStreamer::new(
-        dims,
-        &params,
-        Scratch::new(&mut b, &mut w, dims).expect("scratch"),
-        &mut ring,
-        Mesh::default(),
-    )
-    .expect("streamer");
-    s.push(&[0.0; 16]).expect("slice 0");
-    assert!(s.finish().is_err(), "finishing after 1 of 3 slices");
+    with_streamer(dims, &params, |mut s| {
+        assert!(matches!(s.push(&[0.0; 15]), Err(Error::SliceLength { .. })));
+        s.push(&[1.0; 16]).expect("slice 0");
+        for _ in 0..2 {
+            s.push(&[0.0; 16]).expect("slices 1, 2");
+        }
+        assert_eq!(
+            s.push(&[0.0; 16]),
+            Err(Error::TooManySlices { nz: 3 }),
+            "a fourth slice of three"
+        );
+        let (mesh, stats) = s.finish().expect("finish");
+        assert_eq!(mesh.triangles.len() as u64, stats.triangles);
+    });
+    with_streamer(dims, &params, |mut s| {
+        s.push(&[0.0; 16]).expect("slice 0");
+        assert!(s.finish().is_err(), "finishing after 1 of 3 slices");
+    });
     let mut short_ring = vec![0f32; 3];
     let (mut b, mut w) = (vec![0u8; len.bytes], vec![0u32; len.words]);
     assert!(matches!(
@@ -219,4 +203,13 @@ fn constant_volumes_are_empty() {
     check(i32::MIN, &[-2147483648.0, 0.0]);
     check(0.25f32, &[0.25, 0.3, -1.0]);
     check(f64::NAN, &[0.0, f64::NEG_INFINITY]);
+}
+
+/// Runs `f` on a fresh f32 streamer over `dims`, with scratch and ring buffers lent for the call.
+fn with_streamer(dims: [usize; 3], params: &Params, f: impl FnOnce(SliceStreamer<'_, f32, Mesh>)) {
+    let len = Scratch::len(dims).expect("len");
+    let (mut b, mut w) = (vec![0u8; len.bytes], vec![0u32; len.words]);
+    let mut ring = vec![0f32; SliceStreamer::<f32, Mesh>::ring_len(dims)];
+    let scratch = Scratch::new(&mut b, &mut w, dims).expect("scratch");
+    f(SliceStreamer::new(dims, params, scratch, &mut ring, Mesh::default()).expect("streamer"));
 }
