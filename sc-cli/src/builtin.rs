@@ -3,7 +3,7 @@
 use sc_runtime::demo::{self, DemoVolume};
 
 use crate::cli::Demo;
-use crate::volume::{Grid, Samples};
+use sc_io::volume::{Grid, Samples};
 
 /// The built-in volume `which` at `n` samples per axis, and its iso value.
 pub fn grid(which: Demo, n: usize) -> (Grid, f64) {

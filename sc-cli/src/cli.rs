@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sc_runtime::Mode;
 
-use crate::read::{RawLayout, ReadOptions};
-use crate::volume::{Dtype, Endian};
-use crate::write::MeshFormat;
+use sc_io::read::{RawLayout, ReadOptions};
+use sc_io::volume::{Dtype, Endian};
+use sc_io::write::MeshFormat;
 
 /// Skeleton Climbing isosurfaces from volume files.
 ///

@@ -5,8 +5,8 @@
 //! boundary when there is one dominant contrast; histogram valleys (local minima between two
 //! clear peaks) find boundaries between several tissues or materials.
 
-use crate::volume::{Grid, Range, Sample};
-use crate::with_samples;
+use sc_io::volume::{Grid, Range, Sample};
+use sc_io::with_samples;
 
 /// Counts of finite values in equal bins over `[lo, hi]`, in real units.
 #[derive(Clone, Debug, PartialEq)]
@@ -150,7 +150,7 @@ fn count<T: Sample>(v: &[T], mut f: impl FnMut(f64)) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::volume::Samples;
+    use sc_io::volume::Samples;
 
     fn grid(values: Vec<u8>) -> Grid {
         let n = values.len();

@@ -1,21 +1,16 @@
-//! `skelclimb`: Skeleton Climbing isosurfaces from volume files, as a command and as a library
-//! of readers and writers that the command is a thin layer over.
+//! `skelclimb`: Skeleton Climbing isosurfaces from volume files. The readers and writers live in
+//! `sc-io`, shared with the Python package; this crate is the commands.
 
-pub mod atomic;
 pub mod builtin;
 pub mod check;
 pub mod cli;
 pub mod cmd;
-pub mod error;
 pub mod histogram;
+pub mod interrupt;
 pub mod progress;
-pub mod read;
 pub mod summary;
-pub mod surface;
-pub mod volume;
-pub mod write;
 
-pub use error::{Error, Result};
+pub use sc_io::{Error, Result};
 
 /// Runs a parsed command line.
 pub fn run(cli: &cli::Cli) -> Result<()> {

@@ -6,7 +6,7 @@ use sc_cli::cli::Cli;
 fn main() -> ExitCode {
     // clap exits with status 2 on usage errors it finds.
     let cli = Cli::parse();
-    sc_cli::atomic::remove_temporaries_on_interrupt();
+    sc_cli::interrupt::remove_temporaries_on_interrupt();
     match sc_cli::run(&cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

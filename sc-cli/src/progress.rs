@@ -6,20 +6,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sc_io::progress::Progress;
 
 /// Runs shorter than this finish before a bar would be readable, so it would only flicker.
 const SHOW_AFTER: Duration = Duration::from_millis(500);
 
-/// Progress of the current phase (reading bytes, extracting layers). Shared by reference with the
-/// extractor's worker threads, hence `Sync` and `&self` everywhere.
-pub struct Progress {
+/// A terminal progress bar for the current phase (reading bytes, extracting layers).
+pub struct Bar {
     bar: ProgressBar,
     wanted: bool,
     shown: AtomicBool,
     started: Instant,
 }
 
-impl Progress {
+impl Bar {
     /// A bar that shows itself after [`SHOW_AFTER`] if `enabled` and stderr is a terminal.
     pub fn new(enabled: bool) -> Self {
         let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
@@ -28,7 +28,7 @@ impl Progress {
         ) {
             bar.set_style(style);
         }
-        Progress {
+        Bar {
             bar,
             wanted: enabled && std::io::stderr().is_terminal(),
             shown: AtomicBool::new(false),
@@ -36,20 +36,20 @@ impl Progress {
         }
     }
 
-    /// A bar that never shows, for library callers and tests.
-    pub fn hidden() -> Self {
-        Progress::new(false)
+    /// Removes the bar before the summary is printed.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
     }
+}
 
-    /// Starts a phase of `total` units.
-    pub fn phase(&self, label: &'static str, total: u64) {
+impl Progress for Bar {
+    fn phase(&self, label: &'static str, total: u64) {
         self.bar.set_message(label);
         self.bar.set_length(total);
         self.bar.set_position(0);
     }
 
-    /// Records `n` more units done.
-    pub fn inc(&self, n: u64) {
+    fn inc(&self, n: u64) {
         self.bar.inc(n);
         if self.wanted
             && !self.shown.load(Ordering::Relaxed)
@@ -58,10 +58,5 @@ impl Progress {
         {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
         }
-    }
-
-    /// Removes the bar before the summary is printed.
-    pub fn finish(&self) {
-        self.bar.finish_and_clear();
     }
 }

@@ -6,16 +6,16 @@ use std::time::Instant;
 use sc_runtime::{Mesh, Mode};
 
 use super::warn;
-use crate::atomic::AtomicFile;
 use crate::builtin;
 use crate::check::EdgeReport;
 use crate::cli::{Demo, ExtractArgs, ModeArg};
-use crate::error::{Error, Result};
-use crate::progress::Progress;
-use crate::read::{self, Format};
+use crate::progress::Bar;
 use crate::summary::Summary;
-use crate::surface::{self, Request};
-use crate::write::MeshFormat;
+use sc_io::atomic::AtomicFile;
+use sc_io::error::{Error, Result};
+use sc_io::read::{self, Format};
+use sc_io::surface::{self, Request};
+use sc_io::write::MeshFormat;
 
 /// Reads, extracts, writes and reports. Output files are opened first, so that a bad output
 /// path fails before a long read, and written whole or not at all.
@@ -46,7 +46,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         .as_deref()
         .map(AtomicFile::create)
         .transpose()?;
-    let progress = Progress::new(!quiet);
+    let progress = Bar::new(!quiet);
 
     let clock = Instant::now();
     let (mut grid, iso, input) = match (&args.input, args.demo) {
@@ -107,7 +107,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
                 threads: args.threads,
             };
             Some(
-                surface::extract(&grid, &request, &Progress::hidden())?
+                surface::extract(&grid, &request, &sc_io::progress::Silent)?
                     .stats
                     .triangles,
             )

@@ -3,19 +3,19 @@
 use std::fmt::Write as _;
 
 use crate::cli::InfoArgs;
-use crate::error::Result;
 use crate::histogram::Histogram;
-use crate::progress::Progress;
-use crate::read;
+use crate::progress::Bar;
 use crate::summary::thousands;
-use crate::volume::{Dtype, Grid};
+use sc_io::error::Result;
+use sc_io::read;
+use sc_io::volume::{Dtype, Grid};
 
 /// Bins behind the suggestions: fine enough to separate tissues, coarse enough to smooth noise.
 const SUGGESTION_BINS: usize = 128;
 
 /// Prints what is known about the volume and which iso values to try.
 pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
-    let progress = Progress::new(!quiet);
+    let progress = Bar::new(!quiet);
     let grid = read::read(&args.input, &args.read.read_options(), &progress)?;
     progress.finish();
     print!(

@@ -6,13 +6,13 @@ use sc_runtime::Mode;
 
 use crate::builtin;
 use crate::cli::{Demo, Table1Args, split_iso};
-use crate::error::{Error, Result};
 use crate::histogram::Histogram;
-use crate::progress::Progress;
-use crate::read;
+use crate::progress::Bar;
 use crate::summary::{PAPER_KNOT, thousands};
-use crate::surface::{self, Request};
-use crate::volume::Grid;
+use sc_io::error::{Error, Result};
+use sc_io::read;
+use sc_io::surface::{self, Request};
+use sc_io::volume::Grid;
 
 const MODES: [Mode; 3] = [Mode::Steps123, Mode::Embedded, Mode::Paper];
 
@@ -23,7 +23,7 @@ pub fn run(args: &Table1Args, quiet: bool) -> Result<()> {
     for (path, _) in &files {
         read::Format::detect(path, &options)?;
     }
-    let progress = Progress::new(!quiet);
+    let progress = Bar::new(!quiet);
     println!(
         "{:<40}{:>22}{:>22}{:>22}",
         "triangles (time)", "Steps 1–3", "Steps 1–4 embedded", "Steps 1–4 paper"
@@ -75,7 +75,7 @@ pub fn run(args: &Table1Args, quiet: bool) -> Result<()> {
     Ok(())
 }
 
-fn row(label: &str, grid: &Grid, iso: f64, threads: usize, progress: &Progress) -> Result<()> {
+fn row(label: &str, grid: &Grid, iso: f64, threads: usize, progress: &Bar) -> Result<()> {
     let mut cells = Vec::new();
     for mode in MODES {
         let request = Request {

@@ -34,7 +34,7 @@ struct Slice {
 }
 
 /// Reads the series in `dir`.
-pub fn read(dir: &Path, progress: &Progress) -> Result<Grid> {
+pub fn read(dir: &Path, progress: &dyn Progress) -> Result<Grid> {
     let mut slices = Vec::new();
     for path in dicom_files(dir)? {
         let obj = OpenFileOptions::new()
@@ -269,7 +269,11 @@ fn check_one_series(slices: &[Slice]) -> Result<()> {
 }
 
 /// Decodes every slice into one vector, in slice order.
-fn decode_all<T>(slices: &[Slice], options: &ConvertOptions, progress: &Progress) -> Result<Vec<T>>
+fn decode_all<T>(
+    slices: &[Slice],
+    options: &ConvertOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<T>>
 where
     T: Sample + num_traits::NumCast,
 {

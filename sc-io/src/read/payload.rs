@@ -52,7 +52,11 @@ pub fn decode<'a>(reader: impl Read + 'a, encoding: Encoding) -> Box<dyn Read + 
 ///
 /// A short read says how far the data got, which is what a user needs to tell a truncated
 /// download from wrong dimensions.
-pub fn read_samples(reader: impl Read, layout: Layout, progress: &Progress) -> io::Result<Samples> {
+pub fn read_samples(
+    reader: impl Read,
+    layout: Layout,
+    progress: &dyn Progress,
+) -> io::Result<Samples> {
     with_dtype!(layout.dtype, T => read_typed::<T>(reader, layout, progress).map(Sample::wrap))
 }
 
@@ -62,7 +66,7 @@ const CHUNK: usize = 1 << 22;
 fn read_typed<T: Sample>(
     mut reader: impl Read,
     layout: Layout,
-    progress: &Progress,
+    progress: &dyn Progress,
 ) -> io::Result<Vec<T>> {
     let need = layout.bytes().ok_or_else(|| {
         io::Error::new(
@@ -123,7 +127,7 @@ mod tests {
             endian,
             count,
         };
-        read_samples(decode(bytes, encoding), layout, &Progress::hidden())
+        read_samples(decode(bytes, encoding), layout, &crate::progress::Silent)
     }
 
     #[test]

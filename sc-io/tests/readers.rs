@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use flate2::Compression;
 use flate2::write::{GzEncoder, ZlibEncoder};
-use sc_cli::progress::Progress;
-use sc_cli::read::{RawLayout, ReadOptions, read};
-use sc_cli::volume::{Dtype, Endian, Grid, Samples};
+use sc_io::progress::Silent;
+use sc_io::read::{RawLayout, ReadOptions, read};
+use sc_io::volume::{Dtype, Endian, Grid, Samples};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -17,7 +17,7 @@ fn fixture(name: &str) -> PathBuf {
 }
 
 fn load(path: &Path) -> Grid {
-    read(path, &ReadOptions::default(), &Progress::hidden()).unwrap_or_else(|e| panic!("{e}"))
+    read(path, &ReadOptions::default(), &Silent).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Sum and an order-sensitive checksum of the samples, computed from the reference raw files
@@ -98,7 +98,7 @@ fn npz_matches_the_reference() {
         array: Some("arr_0".into()),
         ..Default::default()
     };
-    let again = read(&fixture("stent-ct.npz"), &named, &Progress::hidden()).unwrap();
+    let again = read(&fixture("stent-ct.npz"), &named, &Silent).unwrap();
     assert_eq!(again.samples, g.samples);
 }
 
@@ -270,7 +270,7 @@ fn raw_with_header_bytes_and_big_endian() {
             raw: Some(raw),
             array: None,
         },
-        &Progress::hidden(),
+        &Silent,
     )
     .unwrap();
     assert_eq!(back.samples, g.samples);

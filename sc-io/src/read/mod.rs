@@ -124,7 +124,7 @@ impl Format {
 }
 
 /// Reads the volume at `path` in whatever format it is.
-pub fn read(path: &Path, options: &ReadOptions, progress: &Progress) -> Result<Grid> {
+pub fn read(path: &Path, options: &ReadOptions, progress: &dyn Progress) -> Result<Grid> {
     let format = Format::detect(path, options)?;
     if !path.exists() {
         return Err(Error::file(path, "no such file or directory"));
@@ -168,7 +168,7 @@ pub struct Block<'a> {
 }
 
 /// Reads a sample block, with errors that name the data file and say what is missing.
-pub fn read_block(block: &Block<'_>, progress: &Progress) -> Result<Samples> {
+pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples> {
     let path = block.path;
     let need = block
         .layout

@@ -20,8 +20,20 @@ pub struct Request {
     pub threads: usize,
 }
 
+impl Request {
+    /// Embedded mode with normals on all cores: what a user wants unless they say otherwise.
+    pub fn new(iso: f64) -> Self {
+        Request {
+            iso,
+            mode: Mode::Embedded,
+            normals: true,
+            threads: 0,
+        }
+    }
+}
+
 /// Extracts the surface of `grid` in world units.
-pub fn extract(grid: &Grid, request: &Request, progress: &Progress) -> Result<Mesh> {
+pub fn extract(grid: &Grid, request: &Request, progress: &dyn Progress) -> Result<Mesh> {
     let mut params = Params::new(grid.scale.invert(request.iso));
     params.mode = request.mode;
     params.normals = request.normals;
@@ -36,7 +48,7 @@ fn run<T: Sample>(
     dims: [usize; 3],
     params: &Params,
     threads: usize,
-    progress: &Progress,
+    progress: &dyn Progress,
 ) -> Result<Mesh> {
     let volume = Volume::new(data, dims)?;
     Ok(extract_par(&volume, params, threads, &|layers| {

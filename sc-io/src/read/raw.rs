@@ -10,7 +10,7 @@ use crate::volume::Grid;
 
 /// Reads `path` as `layout` says. The file size must match exactly: a raw file has nothing else
 /// to catch wrong `--dims` or `--dtype`, and a size mismatch is almost always one.
-pub fn read(path: &Path, layout: &RawLayout, progress: &Progress) -> Result<Grid> {
+pub fn read(path: &Path, layout: &RawLayout, progress: &dyn Progress) -> Result<Grid> {
     let [nx, ny, nz] = layout.dims;
     let count = nx
         .checked_mul(ny)

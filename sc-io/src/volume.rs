@@ -5,7 +5,8 @@ use bytemuck::Pod;
 use sc_runtime::Scalar;
 
 /// The sample types the extractor supports.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Dtype {
     /// Unsigned 8-bit.
     U8,
@@ -67,7 +68,8 @@ impl Dtype {
 }
 
 /// Byte order of stored samples.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Endian {
     /// Least significant byte first (x86, ARM, and most files).
     #[default]

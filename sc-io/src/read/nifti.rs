@@ -17,7 +17,7 @@ use crate::volume::{Dtype, Endian, Grid};
 /// Reads a NIfTI-1 volume. Spacing comes from pixdim; the origin from the sform translation, or
 /// the qform offset; scl_slope/scl_inter map stored values to real ones. Rotations in the
 /// affines are not applied to the mesh: `info` reports them.
-pub fn read(path: &Path, progress: &Progress) -> Result<Grid> {
+pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
     let gz = path.to_string_lossy().to_ascii_lowercase().ends_with(".gz");
     let encoding = if gz { Encoding::Gzip } else { Encoding::Raw };
     let file = File::open(path).map_err(|e| Error::io(path, e))?;

@@ -1,6 +1,7 @@
 //! Output files appear whole or not at all: content goes to a temporary file in the target's
 //! directory (so the final rename cannot cross file systems) and is renamed over the target only
-//! once complete. An error drops the temporary file; Ctrl-C removes it before exiting.
+//! once complete. An error drops the temporary file; a signal handler can remove it with
+//! [`remove_pending`].
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -11,22 +12,17 @@ use tempfile::NamedTempFile;
 
 use crate::error::{Error, Result};
 
-/// Temporary files not yet renamed, for the Ctrl-C handler to remove.
+/// Temporary files not yet renamed, for [`remove_pending`].
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
-/// Makes Ctrl-C (and SIGTERM) remove pending temporary files and exit with status 130. Without
-/// it the rename never happens, so the target is safe anyway, but a stray `.tmp` would remain.
-pub fn remove_temporaries_on_interrupt() {
-    // Failing to install the handler only loses the clean-up, never correctness: ignore it.
-    let _ = ctrlc::set_handler(|| {
-        if let Ok(pending) = PENDING.lock() {
-            for path in pending.iter() {
-                let _ = std::fs::remove_file(path);
-            }
+/// Removes every temporary file not yet renamed. A signal handler calls it before exiting: the
+/// targets are safe without it (the rename never happens), but stray `.tmp` files would remain.
+pub fn remove_pending() {
+    if let Ok(pending) = PENDING.lock() {
+        for path in pending.iter() {
+            let _ = std::fs::remove_file(path);
         }
-        eprintln!("interrupted");
-        std::process::exit(130);
-    });
+    }
 }
 
 /// A file being written to a temporary name beside `target`.

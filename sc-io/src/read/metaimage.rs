@@ -19,7 +19,7 @@ const SYNTAX: Syntax = Syntax {
 };
 
 /// Reads a 3-D scalar MetaImage.
-pub fn read(path: &Path, progress: &Progress) -> Result<Grid> {
+pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
     let mut reader = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
     let h = TextHeader::read(path, &mut reader, 0, &SYNTAX)?;
     drop(reader);

@@ -20,7 +20,7 @@ use crate::volume::{Dtype, Endian, Grid};
 
 /// Reads an `.npy` file, or the array `array` of an `.npz` archive (which may be left out when
 /// the archive holds one array).
-pub fn read(path: &Path, array: Option<&str>, progress: &Progress) -> Result<Grid> {
+pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result<Grid> {
     let is_npz = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
@@ -63,7 +63,7 @@ fn read_array(
     path: &Path,
     header: &NpyHeader,
     reader: impl Read,
-    progress: &Progress,
+    progress: &dyn Progress,
 ) -> Result<Grid> {
     let bad = |message: String| Error::file(path, message);
     let DType::Plain(ty) = header.dtype() else {

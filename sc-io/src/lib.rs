@@ -1,0 +1,24 @@
+//! Volume files in, mesh files out: the readers, writers and sample types that the `skelclimb`
+//! command and the Python package share, so that both read a scan the same way and write the
+//! same bytes.
+//!
+//! ```no_run
+//! use sc_io::{progress::Silent, read, surface, write::MeshFormat, atomic::AtomicFile};
+//!
+//! let grid = read::read("scan.nii.gz".as_ref(), &read::ReadOptions::default(), &Silent)?;
+//! let request = surface::Request::new(300.0);
+//! let mesh = surface::extract(&grid, &request, &Silent)?;
+//! AtomicFile::create("bone.ply".as_ref())?
+//!     .write_with(|out| MeshFormat::Ply.write(&mesh, false, out))?;
+//! # Ok::<(), sc_io::Error>(())
+//! ```
+
+pub mod atomic;
+pub mod error;
+pub mod progress;
+pub mod read;
+pub mod surface;
+pub mod volume;
+pub mod write;
+
+pub use error::{Error, Result};
