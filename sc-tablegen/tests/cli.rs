@@ -137,3 +137,56 @@ fn bad_input_is_a_clear_error() {
     assert_eq!(code, 2);
     assert!(err.contains("not a permutation"), "{err}");
 }
+
+/// Without `--tables`, the commands find the checkout's file from any subdirectory, `dump` uses
+/// the built-in copy outside a checkout, `verify` there says what to do, and `generate` creates
+/// its output folder.
+#[test]
+fn works_from_any_directory() {
+    let inside = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/bin");
+    let out = tablegen()
+        .current_dir(&inside)
+        .arg("verify")
+        .assert()
+        .success();
+    let text = String::from_utf8(out.get_output().stdout.clone()).unwrap();
+    assert!(
+        text.contains("tables/skeleton-climbing.ron matches fresh generation"),
+        "{text}"
+    );
+
+    let outside = tempfile::tempdir().unwrap();
+    let out = tablegen()
+        .current_dir(outside.path())
+        .args(["dump", "--class", "0", "--case", "103"])
+        .assert()
+        .success();
+    let text = String::from_utf8(out.get_output().stdout.clone()).unwrap();
+    assert!(text.starts_with("class 0 case 103"), "{text}");
+    let out = tablegen()
+        .current_dir(outside.path())
+        .arg("verify")
+        .assert()
+        .failure();
+    let err = String::from_utf8(out.get_output().stderr.clone()).unwrap();
+    assert!(err.contains("give --tables PATH"), "{err}");
+
+    let target = outside.path().join("new/dir/t.ron");
+    tablegen()
+        .args(["generate", "--out", target.to_str().unwrap()])
+        .assert()
+        .success();
+    let written = std::fs::read_to_string(&target).unwrap();
+    assert_eq!(written, std::fs::read_to_string(committed()).unwrap());
+    tablegen()
+        .current_dir(outside.path())
+        .arg("generate")
+        .assert()
+        .success();
+    assert!(
+        outside
+            .path()
+            .join("tables/skeleton-climbing.ron")
+            .is_file()
+    );
+}

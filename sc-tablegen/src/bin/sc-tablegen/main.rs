@@ -1,6 +1,7 @@
 //! `sc-tablegen`: generate, verify, inspect and tune the Skeleton Climbing tables.
 
 mod dump;
+mod locate;
 mod measure;
 mod svg;
 
@@ -8,10 +9,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use locate::Source;
 use sc_tablegen::{ORDER0, TableSet};
-
-/// The committed tables, relative to the workspace root.
-const DEFAULT_TABLES: &str = "tables/skeleton-climbing.ron";
 
 #[derive(Parser)]
 #[command(
@@ -27,24 +26,27 @@ struct Cli {
 enum Command {
     /// Generate and validate all 2048 entries, then write them as RON.
     Generate {
-        /// Where to write the tables.
-        #[arg(long, default_value = DEFAULT_TABLES)]
-        out: PathBuf,
+        /// Where to write the tables; its folder is created if missing [default: the checkout's
+        /// tables/skeleton-climbing.ron, or ./tables/skeleton-climbing.ron outside a checkout].
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Class 0's order of the nine non-grey edges, comma-separated (default: the chosen one).
         #[arg(long, value_parser = parse_order)]
         order: Option<[u8; 9]>,
     },
     /// Fail (exit 1) with a diff summary when the tables file differs from fresh generation.
     Verify {
-        /// The committed tables file.
-        #[arg(long, default_value = DEFAULT_TABLES)]
-        tables: PathBuf,
+        /// The committed tables file [default: tables/skeleton-climbing.ron in the checkout that
+        /// holds the current directory].
+        #[arg(long)]
+        tables: Option<PathBuf>,
     },
     /// Show entries, statistics or pictures of a tables file.
     Dump {
-        /// The tables file to read.
-        #[arg(long, default_value = DEFAULT_TABLES)]
-        tables: PathBuf,
+        /// The tables file to read [default: the checkout's, or the copy built into this binary
+        /// outside a checkout].
+        #[arg(long)]
+        tables: Option<PathBuf>,
         /// Parity class 0..=7 (default: all classes).
         #[arg(long, value_parser = clap::value_parser!(u8).range(0..8))]
         class: Option<u8>,
@@ -96,6 +98,7 @@ fn run(command: Command) -> Result<(), String> {
     match command {
         Command::Generate { out, order } => {
             let set = generate(&order.unwrap_or(ORDER0))?;
+            let out = out.unwrap_or_else(locate::default_output);
             write_atomic(&out, &set.to_ron())?;
             println!(
                 "wrote {} ({} entries, all valid)",
@@ -105,17 +108,16 @@ fn run(command: Command) -> Result<(), String> {
             Ok(())
         }
         Command::Verify { tables } => {
-            let committed = load(&tables)?;
+            let source = Source::find(tables, false)?;
+            let committed = load(&source)?;
+            let tables = source.describe();
             let fresh = generate(&ORDER0)?;
             if committed.to_ron() == fresh.to_ron() {
-                println!(
-                    "{} matches fresh generation (2048 entries)",
-                    tables.display()
-                );
+                println!("{tables} matches fresh generation (2048 entries)");
                 return Ok(());
             }
             let diffs = dump::diff(&committed, &fresh);
-            let mut msg = format!("{} differs from fresh generation: ", tables.display());
+            let mut msg = format!("{tables} differs from fresh generation: ");
             if committed.order != fresh.order {
                 msg.push_str(&format!(
                     "order {:?} vs built-in {:?}; ",
@@ -140,7 +142,7 @@ fn run(command: Command) -> Result<(), String> {
             stats,
             svg,
         } => {
-            let set = load(&tables)?;
+            let set = load(&Source::find(tables, true)?)?;
             if stats {
                 print!("{}", dump::stats(&set));
                 return Ok(());
@@ -188,14 +190,21 @@ fn generate(order: &[u8; 9]) -> Result<TableSet, String> {
     })
 }
 
-fn load(path: &Path) -> Result<TableSet, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    TableSet::from_ron(&text).map_err(|e| format!("{}: malformed tables: {e}", path.display()))
+fn load(source: &Source) -> Result<TableSet, String> {
+    let text = match source {
+        Source::File(path) => std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read {}: {e}", path.display()))?,
+        Source::Embedded => locate::EMBEDDED.to_string(),
+    };
+    TableSet::from_ron(&text).map_err(|e| format!("{}: malformed tables: {e}", source.describe()))
 }
 
 /// Writes through a temporary file in the same directory, so a failure never leaves half a table.
 fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
     let tmp = path.with_extension("ron.tmp");
     std::fs::write(&tmp, text)
         .and_then(|()| std::fs::rename(&tmp, path))
