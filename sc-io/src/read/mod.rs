@@ -10,6 +10,7 @@ pub mod npy;
 pub mod nrrd;
 pub mod payload;
 pub mod raw;
+pub mod sidecar;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom};
@@ -59,6 +60,8 @@ pub enum Format {
     Npz,
     /// A directory of DICOM slices.
     Dicom,
+    /// Raw samples described by a JSON sidecar (see [`sidecar`]).
+    Sidecar,
 }
 
 impl Format {
@@ -83,6 +86,8 @@ impl Format {
             Format::Npz
         } else if let Some(layout) = options.raw {
             Format::Raw(layout)
+        } else if sidecar::find(path).is_some() {
+            Format::Sidecar
         } else if ends(&[".dcm"]) {
             return Err(Error::Usage(format!(
                 "{}: give the directory that holds the DICOM series, not one slice",
@@ -91,7 +96,8 @@ impl Format {
         } else {
             return Err(Error::Usage(format!(
                 "{}: unknown volume format; expected .nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, \
-                 .npy, .npz, a DICOM directory, or raw samples with --dims and --dtype",
+                 .npy, .npz, a DICOM directory, raw samples with --dims and --dtype, or raw samples \
+                 with a .json sidecar",
                 path.display()
             )));
         };
@@ -119,6 +125,7 @@ impl Format {
             Format::Npy => "NumPy .npy",
             Format::Npz => "NumPy .npz",
             Format::Dicom => "DICOM series",
+            Format::Sidecar => "raw + JSON sidecar",
         }
     }
 }
@@ -136,8 +143,30 @@ pub fn read(path: &Path, options: &ReadOptions, progress: &dyn Progress) -> Resu
         Format::MetaImage => metaimage::read(path, progress),
         Format::Npy | Format::Npz => npy::read(path, options.array.as_deref(), progress),
         Format::Dicom => dicom::read(path, progress),
+        Format::Sidecar => read_with_sidecar(path, progress),
     }?;
     grid.format = format.name();
+    Ok(grid)
+}
+
+fn read_with_sidecar(path: &Path, progress: &dyn Progress) -> Result<Grid> {
+    let json = sidecar::find(path).ok_or_else(|| Error::file(path, "no JSON sidecar beside it"))?;
+    let side = sidecar::Sidecar::read(&json)?;
+    let mut grid = raw::read(&side.data, &side.layout, progress)?;
+    grid.spacing = side.spacing.unwrap_or(grid.spacing);
+    grid.origin = side.origin.unwrap_or(grid.origin);
+    if !side.iso_suggestions.is_empty() {
+        let named: Vec<String> = side
+            .iso_suggestions
+            .iter()
+            .map(|(name, iso)| format!("{name} {iso}"))
+            .collect();
+        grid.notes.push(format!(
+            "{} suggests iso values: {}",
+            json.display(),
+            named.join(", ")
+        ));
+    }
     Ok(grid)
 }
 

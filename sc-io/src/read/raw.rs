@@ -15,7 +15,7 @@ pub fn read(path: &Path, layout: &RawLayout, progress: &dyn Progress) -> Result<
     let count = nx
         .checked_mul(ny)
         .and_then(|n| n.checked_mul(nz))
-        .ok_or_else(|| Error::file(path, "--dims overflow"))?;
+        .ok_or_else(|| Error::file(path, "the dims overflow"))?;
     let block_layout = Layout {
         dtype: layout.dtype,
         endian: layout.endian,
@@ -29,8 +29,8 @@ pub fn read(path: &Path, layout: &RawLayout, progress: &dyn Progress) -> Result<
         return Err(Error::file(
             path,
             format!(
-                "the file has {len} bytes, but --dims {nx},{ny},{nz} of {} with {} header bytes \
-                 needs {}",
+                "the file has {len} bytes, but dims {nx},{ny},{nz} of {} with {} header bytes \
+                 need {}",
                 layout.dtype.name(),
                 layout.header_bytes,
                 need.map_or("more than fits in memory".into(), |n| n.to_string())
