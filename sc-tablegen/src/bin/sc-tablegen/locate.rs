@@ -54,7 +54,7 @@ pub fn default_output() -> PathBuf {
 /// Cargo workspace holding one.
 fn workspace_file() -> Option<PathBuf> {
     let cwd = std::env::current_dir().ok()?;
-    cwd.ancestors().find_map(|dir| tables_in(dir))
+    cwd.ancestors().find_map(tables_in)
 }
 
 fn tables_in(dir: &Path) -> Option<PathBuf> {
