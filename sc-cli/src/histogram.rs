@@ -63,7 +63,9 @@ impl Histogram {
         self.lo + self.width() * i as f64
     }
 
-    /// Otsu's threshold: the bin edge that best splits the values into two classes.
+    /// Otsu's threshold: the bin edge that best splits the values into two classes. Empty bins
+    /// between two clusters all split them equally well; the middle of that run is returned,
+    /// not its first edge, which would sit at the very top of the lower cluster.
     pub fn otsu(&self) -> Option<f64> {
         let total: u64 = self.counts.iter().sum();
         let centre = |i: usize| self.edge(i) + self.width() / 2.0;
@@ -74,7 +76,7 @@ impl Histogram {
             .map(|(i, &c)| c as f64 * centre(i))
             .sum();
         let (mut w0, mut sum0) = (0.0, 0.0);
-        let mut best = None;
+        let mut best: Option<(usize, usize)> = None;
         let mut best_var = 0.0;
         for (i, &c) in self.counts.iter().enumerate().take(self.counts.len() - 1) {
             w0 += c as f64;
@@ -85,34 +87,45 @@ impl Histogram {
             }
             let diff = sum0 / w0 - (sum_all - sum0) / w1;
             let var = w0 * w1 * diff * diff;
-            if var > best_var {
-                best_var = var;
-                best = Some(self.edge(i + 1));
+            let tie = (var - best_var).abs() <= best_var * 1e-12;
+            match best {
+                Some((first, last)) if tie && last + 1 == i && c == 0 => best = Some((first, i)),
+                _ if var > best_var && !tie => {
+                    best_var = var;
+                    best = Some((i, i));
+                }
+                _ => {}
             }
         }
-        best
+        best.map(|(first, last)| (self.edge(first + 1) + self.edge(last + 1)) / 2.0)
     }
 
     /// Up to `max` valleys `(centre, left peak, right peak)`, deepest first: bins of the smoothed
     /// histogram that are lower than both neighbours and at most half the smaller of the highest
     /// peaks on each side. Smoothing over 7 bins bridges the empty bins of quantised data (CT
-    /// values in steps of 62.5, say), which would otherwise look like valleys.
+    /// values in steps of 62.5, say), which would otherwise look like valleys. A peak must hold
+    /// [`PEAK_SHARE`] of the samples, so that a few saturated values at the top of the range do
+    /// not make a "tissue"; one valley is kept per pair of peaks, since two minima between the
+    /// same peaks separate the same two things.
     pub fn valleys(&self, max: usize) -> Vec<(f64, f64, f64)> {
         let n = self.counts.len();
+        let total: u64 = self.counts.iter().sum();
+        let window = 2 * SMOOTH + 1;
         let smooth: Vec<f64> = (0..n)
             .map(|i| {
-                let window = i.saturating_sub(SMOOTH)..(i + SMOOTH + 1).min(n);
-                let len = window.len() as f64;
-                self.counts[window].iter().sum::<u64>() as f64 / len
+                let bins = i.saturating_sub(SMOOTH)..(i + SMOOTH + 1).min(n);
+                let len = bins.len() as f64;
+                self.counts[bins].iter().sum::<u64>() as f64 / len
             })
             .collect();
+        let least_peak = total as f64 * PEAK_SHARE / window as f64;
         let centre = |i: usize| self.edge(i) + self.width() / 2.0;
         let peak = |range: &mut dyn Iterator<Item = usize>| {
             range
                 .map(|j| (smooth[j], j))
                 .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a })
         };
-        let mut found: Vec<(f64, f64, f64, f64)> = Vec::new();
+        let mut found: Vec<(f64, f64, usize, usize)> = Vec::new();
         for i in 1..n.saturating_sub(1) {
             if !(smooth[i] < smooth[i - 1] && smooth[i] <= smooth[i + 1]) {
                 continue;
@@ -120,25 +133,25 @@ impl Histogram {
             let (left, l) = peak(&mut (0..i));
             let (right, r) = peak(&mut (i + 1..n));
             let floor = left.min(right);
-            if floor > 0.0 && smooth[i] <= floor / 2.0 {
-                found.push((floor - smooth[i], centre(i), centre(l), centre(r)));
+            if floor >= least_peak && floor > 0.0 && smooth[i] <= floor / 2.0 {
+                found.push((floor - smooth[i], centre(i), l, r));
             }
         }
         found.sort_by(|a, b| b.0.total_cmp(&a.0));
-        // Neighbouring minima of one broad valley are one suggestion, not several.
-        let mut kept: Vec<(f64, f64, f64)> = Vec::new();
+        let mut kept: Vec<(f64, usize, usize)> = Vec::new();
         for (_, v, l, r) in found {
-            if kept.len() < max
-                && kept
-                    .iter()
-                    .all(|k| (k.0 - v).abs() > 4.0 * SMOOTH as f64 * self.width())
-            {
+            if kept.len() < max && kept.iter().all(|k| (k.1, k.2) != (l, r)) {
                 kept.push((v, l, r));
             }
         }
-        kept
+        kept.into_iter()
+            .map(|(v, l, r)| (v, centre(l), centre(r)))
+            .collect()
     }
 }
+
+/// The share of all samples a histogram peak must hold (within the smoothing window) to count.
+const PEAK_SHARE: f64 = 1e-3;
 
 /// Half-width of the smoothing window, in bins.
 const SMOOTH: usize = 3;
@@ -173,6 +186,35 @@ mod tests {
             valleys.iter().all(|(v, l, r)| l < v && v < r),
             "{valleys:?}"
         );
+    }
+
+    /// Two minima between the same two peaks are one suggestion, and a peak of a few saturated
+    /// samples at the top is no peak.
+    #[test]
+    fn one_valley_per_pair_of_peaks_and_no_tiny_peaks() {
+        let mut v = vec![0u8; 4000];
+        v.extend(vec![60u8; 2000]);
+        // A shallow bump between the two minima on either side of it.
+        v.extend(vec![30u8; 100]);
+        v.extend(vec![255u8; 3]);
+        let g = grid(v);
+        let h = Histogram::of(&g, &g.range(), 128);
+        let valleys = h.valleys(3);
+        assert_eq!(valleys.len(), 1, "{valleys:?}");
+        let (valley, left, right) = valleys[0];
+        assert!(left < 5.0 && right > 50.0 && right < 65.0, "{valleys:?}");
+        assert!(valley > left && valley < right);
+    }
+
+    /// With nothing between two clusters, the threshold is halfway, not at the lower cluster.
+    #[test]
+    fn otsu_takes_the_middle_of_an_empty_gap() {
+        let mut v = vec![10u8; 500];
+        v.extend(vec![200u8; 300]);
+        let g = grid(v);
+        let h = Histogram::of(&g, &g.range(), 64);
+        let t = h.otsu().unwrap();
+        assert!((t - 105.0).abs() <= h.width(), "{t}");
     }
 
     #[test]

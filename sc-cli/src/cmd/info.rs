@@ -8,7 +8,7 @@ use crate::progress::Bar;
 use crate::summary::thousands;
 use sc_io::error::Result;
 use sc_io::read;
-use sc_io::volume::{Dtype, Grid};
+use sc_io::volume::{Dtype, Grid, Range};
 
 /// Bins behind the suggestions: fine enough to separate tissues, coarse enough to smooth noise.
 const SUGGESTION_BINS: usize = 128;
@@ -136,11 +136,32 @@ pub fn describe(name: &str, grid: &Grid, bins: usize) -> String {
                 short(r)
             );
         }
+        if is_hounsfield(&range) {
+            for (level, what) in CT_LEVELS {
+                let _ = writeln!(out, "    {:<10} {what}", short(snap(level)));
+            }
+        }
     }
     for note in &grid.notes {
         let _ = writeln!(out, "  note      {note}");
     }
     out
+}
+
+/// The usual CT surface levels, in Hounsfield units.
+const CT_LEVELS: [(f64, &str); 2] = [
+    (
+        -500.0,
+        "skin: air against soft tissue (CT, Hounsfield units)",
+    ),
+    (350.0, "bone: usual level 300 to 400 (CT, Hounsfield units)"),
+];
+
+/// Whether the values look like CT in Hounsfield units: air near −1000 (or the −1024 to −3024
+/// padding scanners write outside the field of view) and values up to bone. No other modality
+/// stores large negative values, so the range alone tells.
+fn is_hounsfield(range: &Range) -> bool {
+    range.min <= -900.0 && range.min >= -3100.0 && range.max >= 300.0
 }
 
 /// A value for reading: at most four decimals, no trailing zeros, no negative zero.
@@ -160,4 +181,30 @@ fn short(x: f64) -> String {
 
 fn ln1p(c: u64) -> f64 {
     (c as f64).ln_1p()
+}
+
+#[cfg(test)]
+mod tests {
+    use sc_io::volume::Samples;
+
+    use super::*;
+
+    fn report(values: Vec<i16>) -> String {
+        let n = values.len();
+        describe("t", &Grid::new(Samples::I16(values), [n, 1, 1], "test"), 16)
+    }
+
+    #[test]
+    fn ct_in_hounsfield_units_gets_the_tissue_levels() {
+        let mut ct = vec![-1000i16; 3000];
+        ct.extend(vec![40i16; 3000]);
+        ct.extend(vec![900i16; 500]);
+        let text = report(ct);
+        let line = |start: &str| text.lines().any(|l| l.trim_start().starts_with(start));
+        assert!(line("-499.5     skin"), "{text}");
+        assert!(line("350.5      bone"), "{text}");
+        // An MRI-like range (no large negative values) gets no CT levels.
+        let text = report((0..600).map(|i| i % 300).collect());
+        assert!(!text.contains("Hounsfield"), "{text}");
+    }
 }
