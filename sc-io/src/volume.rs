@@ -51,6 +51,22 @@ impl Dtype {
         }
     }
 
+    /// The type named `name`, as this crate spells it (`u8`, `f32`) or as NumPy does (`uint8`,
+    /// `float32`).
+    pub fn from_name(name: &str) -> Option<Dtype> {
+        Some(match name {
+            "u8" | "uint8" => Dtype::U8,
+            "i8" | "int8" => Dtype::I8,
+            "u16" | "uint16" => Dtype::U16,
+            "i16" | "int16" => Dtype::I16,
+            "u32" | "uint32" => Dtype::U32,
+            "i32" | "int32" => Dtype::I32,
+            "f32" | "float32" => Dtype::F32,
+            "f64" | "float64" => Dtype::F64,
+            _ => return None,
+        })
+    }
+
     /// The type for `(kind, bytes)` as most formats describe it: `'u'`, `'i'` or `'f'`.
     pub fn from_kind(kind: char, bytes: usize) -> Option<Dtype> {
         Some(match (kind, bytes) {

@@ -58,7 +58,7 @@ impl Sidecar {
             .ok_or_else(|| bad("dims", "must be three positive whole numbers"))?;
         let dtype = field("dtype")
             .and_then(Value::as_str)
-            .and_then(parse_dtype)
+            .and_then(Dtype::from_name)
             .ok_or_else(|| {
                 bad(
                     "dtype",
@@ -117,21 +117,6 @@ impl Sidecar {
 fn triple<T>(v: &Value, item: impl Fn(&Value) -> Option<T>) -> Option<[T; 3]> {
     let items: Vec<T> = v.as_array()?.iter().map(item).collect::<Option<_>>()?;
     items.try_into().ok()
-}
-
-/// Our names and NumPy's.
-fn parse_dtype(name: &str) -> Option<Dtype> {
-    Some(match name {
-        "u8" | "uint8" => Dtype::U8,
-        "i8" | "int8" => Dtype::I8,
-        "u16" | "uint16" => Dtype::U16,
-        "i16" | "int16" => Dtype::I16,
-        "u32" | "uint32" => Dtype::U32,
-        "i32" | "int32" => Dtype::I32,
-        "f32" | "float32" => Dtype::F32,
-        "f64" | "float64" => Dtype::F64,
-        _ => return None,
-    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,276 @@
+"""Skeleton Climbing isosurfaces: about 25 % fewer triangles than Marching Cubes.
+
+>>> import numpy as np, skelclimb
+>>> z, y, x = np.mgrid[-1:1:32j, -1:1:32j, -1:1:32j]
+>>> ball = (0.8 - np.sqrt(x * x + y * y + z * z)).astype(np.float32)
+>>> mesh = skelclimb.extract(ball, 0.0)
+>>> mesh.faces.shape[0] < mesh.stats["steps123"]["triangles"]
+True
+
+Two entry points:
+
+* :func:`extract` is this package's own call: vertices in ``(x, y, z)`` order, where ``x`` is the
+  fastest-varying axis in memory (the last axis of a C-ordered array), spacing and origin in the
+  same order. This is how the ``skelclimb`` command reads NumPy files.
+* :func:`marching_cubes` is a drop-in for ``skimage.measure.marching_cubes``: vertices in the
+  array's own axis order, the same winding, the same return value.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _native
+
+__all__ = ["Mesh", "SliceStreamer", "extract", "load", "marching_cubes"]
+
+_MODES = ("embedded", "paper", "steps123")
+
+
+class Mesh:
+    """An indexed triangle mesh.
+
+    Attributes
+    ----------
+    vertices : (V, 3) float32 array
+        Positions, ``(x, y, z)`` in world units (index × spacing + origin).
+    faces : (T, 3) uint32 array
+        Vertex indices, wound so that ``(b - a) × (c - a)`` points out of the region
+        ``volume >= level``.
+    normals : (V, 3) float32 array or None
+        Unit normals pointing out of that region, if asked for.
+    stats : dict
+        ``steps123`` and ``result`` (vertex and triangle counts), ``merged`` and ``blocked``
+        grey edges, ``reduction_percent``, ``mode``, ``iso``, ``dims`` (``[nx, ny, nz]``).
+    """
+
+    __slots__ = ("vertices", "faces", "normals", "stats")
+
+    def __init__(self, vertices, faces, normals=None, stats=None):
+        self.vertices = vertices
+        self.faces = faces
+        self.normals = normals
+        self.stats = {} if stats is None else stats
+
+    def __repr__(self):
+        return f"Mesh({len(self.vertices)} vertices, {len(self.faces)} triangles)"
+
+    def save(self, path, *, ascii=False):
+        """Writes the mesh to ``path``: ``.ply``, ``.obj``, ``.stl`` or ``.glb`` by extension.
+
+        The file appears whole or not at all (it is written to a temporary file and renamed),
+        with the same writers as the ``skelclimb`` command.
+
+        >>> mesh.save("ball.ply")  # doctest: +SKIP
+        """
+        vertices = np.ascontiguousarray(self.vertices, dtype=np.float32)
+        faces = np.ascontiguousarray(self.faces, dtype=np.uint32)
+        normals = None
+        if self.normals is not None:
+            normals = np.ascontiguousarray(self.normals, dtype=np.float32)
+        _native.save(str(path), vertices, faces, normals, ascii)
+
+    def to_trimesh(self):
+        """The mesh as a ``trimesh.Trimesh`` (needs the ``trimesh`` package)."""
+        import trimesh
+
+        return trimesh.Trimesh(
+            vertices=self.vertices,
+            faces=self.faces,
+            vertex_normals=self.normals,
+            process=False,
+        )
+
+    def to_pyvista(self):
+        """The mesh as a ``pyvista.PolyData`` (needs the ``pyvista`` package)."""
+        import pyvista
+
+        faces = np.hstack(
+            [np.full((len(self.faces), 1), 3, dtype=np.int64), self.faces.astype(np.int64)]
+        )
+        poly = pyvista.PolyData(np.asarray(self.vertices), faces.ravel())
+        if self.normals is not None:
+            poly.point_data["Normals"] = self.normals
+        return poly
+
+
+def _triple(value, name):
+    try:
+        items = tuple(float(v) for v in value)
+    except TypeError:
+        raise TypeError(f"{name}: expected three numbers, got {value!r}") from None
+    if len(items) != 3:
+        raise ValueError(f"{name}: expected three numbers, got {len(items)}")
+    return items
+
+
+def _volume(volume, name="volume"):
+    """A 3-D array the native code can borrow: C or Fortran contiguous, native byte order."""
+    if not isinstance(volume, np.ndarray):
+        raise TypeError(f"{name}: expected a NumPy array, got {type(volume).__name__}")
+    if volume.ndim != 3:
+        raise ValueError(f"{name}: expected a 3-D array, got {volume.ndim} dimensions")
+    if volume.dtype == np.bool_:
+        volume = volume.view(np.uint8)
+    if not volume.dtype.isnative:
+        volume = volume.astype(volume.dtype.newbyteorder("="))
+    if not (volume.flags.c_contiguous or volume.flags.f_contiguous):
+        volume = np.ascontiguousarray(volume)
+    return volume
+
+
+def _level(level):
+    try:
+        level = float(level)
+    except (TypeError, ValueError):
+        raise TypeError(f"level: expected a number, got {level!r}") from None
+    if not np.isfinite(level):
+        raise ValueError(f"level: must be finite, got {level}")
+    return level
+
+
+def _pad(volume, level):
+    """``volume`` with one layer around it that is empty at ``level``, so every surface closes."""
+    if np.issubdtype(volume.dtype, np.integer):
+        below = np.ceil(level) - 1
+        info = np.iinfo(volume.dtype)
+        if below < info.min:
+            raise ValueError(f"pad: no {volume.dtype} value is below level {level}")
+        fill = volume.dtype.type(min(below, info.max))
+    else:
+        finite = volume[np.isfinite(volume)]
+        low = finite.min() if finite.size else level
+        fill = low if low < level else np.nextafter(volume.dtype.type(level), -np.inf)
+    order = "F" if volume.flags.f_contiguous and not volume.flags.c_contiguous else "C"
+    return np.pad(volume, 1, constant_values=fill), order
+
+
+def extract(
+    volume,
+    level,
+    *,
+    spacing=(1, 1, 1),
+    origin=(0, 0, 0),
+    mode="embedded",
+    pad=False,
+    normals=True,
+    threads=0,
+):
+    """Meshes the surface ``volume == level``; samples ``>= level`` are inside.
+
+    Parameters
+    ----------
+    volume : 3-D ndarray
+        uint8, int8, uint16, int16, uint32, int32, float32 or float64 (bool is read as uint8).
+        A C-ordered array of shape ``(nz, ny, nx)`` or a Fortran-ordered one of shape
+        ``(nx, ny, nz)`` is used **without copying**; a non-contiguous view (a slice with a step,
+        a transposed C array that is neither order) is copied once, and so is an array in
+        non-native byte order.
+    level : float
+        The iso value. Integer volumes are compared exactly in their own type.
+    spacing, origin : three floats, ``(x, y, z)``
+        Vertex positions are ``index × spacing + origin``.
+    mode : ``"embedded"`` (default), ``"paper"`` or ``"steps123"``
+        ``embedded`` merges only where the surface stays a closed 2-manifold, ``paper`` merges
+        every interior grey edge as the paper does, ``steps123`` does not merge (the Marching
+        Cubes triangle count).
+    pad : bool
+        Surround the volume with one layer of empty samples (a copy), so every surface is
+        closed; positions stay in the unpadded volume's coordinates.
+    normals : bool
+        Compute per-vertex normals.
+    threads : int
+        Worker threads, 0 for all cores. The mesh is identical for any number. The GIL is
+        released while the mesh is built.
+
+    Returns
+    -------
+    Mesh
+
+    Examples
+    --------
+    >>> import numpy as np, skelclimb
+    >>> v = np.zeros((8, 8, 8), np.uint8); v[2:6, 2:6, 2:6] = 1
+    >>> m = skelclimb.extract(v, 1)
+    >>> m.stats["result"]["triangles"] < m.stats["steps123"]["triangles"]
+    True
+    """
+    volume = _volume(volume)
+    level = _level(level)
+    spacing = _triple(spacing, "spacing")
+    origin = _triple(origin, "origin")
+    if mode not in _MODES:
+        raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
+    threads = int(threads)
+    if threads < 0:
+        raise ValueError(f"threads: must be 0 (all cores) or more, got {threads}")
+    if pad:
+        volume, order = _pad(volume, level)
+        volume = np.asarray(volume, order=order)
+        origin = tuple(o - s for o, s in zip(origin, spacing))
+    verts, faces, norms, stats = _native.extract(
+        volume, level, spacing, origin, mode, bool(normals), threads
+    )
+    return Mesh(verts, faces, norms, stats)
+
+
+def load(path, **options):
+    """Reads a volume file with the ``skelclimb`` command's readers.
+
+    NIfTI (``.nii``, ``.nii.gz``), NRRD (``.nrrd``, ``.nhdr``), MetaImage (``.mha``, ``.mhd``),
+    NumPy (``.npy``, ``.npz``; ``array=`` picks an array), a DICOM series (a directory), raw
+    samples with ``dims=(nx, ny, nz), dtype="i16"`` (and ``endian=``, ``header_bytes=``), or raw
+    samples with a JSON sidecar.
+
+    Returns ``(volume, spacing, origin)``: a C-ordered array of shape ``(nz, ny, nx)``, and spacing
+    and origin as ``(x, y, z)``, ready for :func:`extract`. A rescale slope and intercept in the
+    file are applied.
+
+    >>> vol, spacing, origin = skelclimb.load("head.nii.gz")  # doctest: +SKIP
+    >>> mesh = skelclimb.extract(vol, 300, spacing=spacing, origin=origin)  # doctest: +SKIP
+    """
+    if "dims" in options and options["dims"] is not None:
+        options["dims"] = tuple(int(d) for d in options["dims"])
+    volume, spacing, origin = _native.load(str(path), **options)
+    return volume, tuple(spacing), tuple(origin)
+
+
+class SliceStreamer:
+    """Meshes a volume of shape ``(nz, ny, nx)`` fed one z-slice at a time, holding four slices.
+
+    For volumes read slice by slice (h5py, zarr, a microscope): memory stays that of a few
+    slices plus the mesh, and the mesh equals :func:`extract`'s on the whole array. Rust meshes
+    on its own thread while Python reads the next slice.
+
+    >>> s = skelclimb.SliceStreamer((nz, ny, nx), level=300)  # doctest: +SKIP
+    >>> for z in range(nz):  # doctest: +SKIP
+    ...     s.push(dataset[z])
+    >>> mesh = s.finish()  # doctest: +SKIP
+    """
+
+    def __init__(self, shape, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded",
+                 normals=True):
+        shape = tuple(int(n) for n in shape)
+        if len(shape) != 3 or min(shape) < 0:
+            raise ValueError(f"shape: expected (nz, ny, nx), got {shape!r}")
+        if mode not in _MODES:
+            raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
+        self._native = _native.SliceStreamer(
+            shape, _level(level), _triple(spacing, "spacing"), _triple(origin, "origin"), mode,
+            bool(normals),
+        )
+
+    def push(self, slice):
+        """Takes the next z-slice: a 2-D array of shape ``(ny, nx)`` of any real dtype."""
+        slice = np.asarray(slice)
+        if slice.ndim != 2:
+            raise ValueError(f"slice: expected a 2-D array, got {slice.ndim} dimensions")
+        self._native.push(np.ascontiguousarray(slice, dtype=np.float64))
+
+    def finish(self):
+        """Finishes after all ``nz`` slices and returns the :class:`Mesh`."""
+        verts, faces, norms, stats = self._native.finish()
+        return Mesh(verts, faces, norms, stats)
+
+
+from ._skimage import marching_cubes  # noqa: E402  (needs extract above)

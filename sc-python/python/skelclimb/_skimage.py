@@ -1,0 +1,185 @@
+"""A drop-in for ``skimage.measure.marching_cubes``, meshing with Skeleton Climbing."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _native, _triple, _volume
+
+_METHODS = ("lewiner", "lorensen")
+
+# scikit-image converts anything else to float32; we keep these types as they are.
+_NATIVE_TYPES = tuple(
+    np.dtype(t) for t in ("u1", "i1", "u2", "i2", "u4", "i4", "f4", "f8")
+)
+
+
+def marching_cubes(
+    volume,
+    level=None,
+    *,
+    spacing=(1.0, 1.0, 1.0),
+    gradient_direction="descent",
+    step_size=1,
+    allow_degenerate=True,
+    method="lewiner",
+    mask=None,
+):
+    """Skeleton Climbing with the signature and results of ``skimage.measure.marching_cubes``.
+
+    Replace ``from skimage.measure import marching_cubes`` with
+    ``from skelclimb import marching_cubes`` and a script keeps working, with about 25 % fewer
+    triangles (Steps 1–4, embedded mode: a closed, consistently oriented surface where the
+    volume's border is empty).
+
+    Parameters
+    ----------
+    volume : (M, N, P) ndarray
+        The data. uint8 to int32, float32 and float64 are meshed in their own type without a
+        copy (C- or Fortran-ordered); other types are converted to float64, bool to uint8.
+    level : float, optional
+        The iso value; by default ``(volume.min() + volume.max()) / 2``. A level outside the
+        data's range is a ``ValueError``, as in scikit-image.
+    spacing : three floats
+        Voxel spacing along the array's axes.
+    gradient_direction : ``'descent'`` or ``'ascent'``
+        Face winding, as scikit-image does it: ``descent`` (the object is where the data is
+        greater) and ``ascent`` give opposite windings of the same triangles. Normals point
+        down the gradient either way.
+    step_size : int
+        Mesh every ``step_size``-th sample along each axis (faster, coarser), as scikit-image.
+    allow_degenerate : bool
+        Accepted for compatibility. Skeleton Climbing never makes zero-area triangles (vertices
+        stay at least 1/1024 of an edge from its ends), so there is nothing to remove.
+    method : ``'lewiner'`` or ``'lorensen'``
+        Checked, otherwise ignored: the surface is always Skeleton Climbing's.
+    mask : (M, N, P) bool ndarray, optional
+        Keep only triangles in cubes whose lower corner is True, as scikit-image does. A merged
+        triangle spans two cubes and is kept when the cube holding its centroid is.
+
+    Returns
+    -------
+    verts : (V, 3) float32 array
+        Positions in the array's axis order, times ``spacing``.
+    faces : (F, 3) int32 array
+        Vertex indices.
+    normals : (V, 3) float32 array
+        Unit normals, in the array's axis order.
+    values : (V,) float32 array
+        The larger of the two samples at the ends of each vertex's grid edge, for colouring.
+        (scikit-image takes a maximum over a larger neighbourhood; the figures differ.)
+    """
+    if not isinstance(volume, np.ndarray) or volume.ndim != 3:
+        raise ValueError("Input volume should be a 3D numpy array.")
+    if min(volume.shape) < 2:
+        raise ValueError("Input array must be at least 2x2x2.")
+    if method not in _METHODS:
+        raise ValueError(f"method should be either 'lewiner' or 'lorensen', got {method!r}")
+    if gradient_direction not in ("descent", "ascent"):
+        raise ValueError("Incorrect input gradient_direction.")
+    spacing = _triple(spacing, "spacing")
+    if not all(np.isfinite(s) and s > 0 for s in spacing):
+        raise ValueError(f"spacing: must be three positive numbers, got {spacing}")
+    step_size = int(step_size)
+    if step_size < 1:
+        raise ValueError("step_size must be at least one.")
+    if mask is not None:
+        mask = np.asarray(mask)
+        if mask.shape != volume.shape:
+            raise ValueError("volume and mask must have the same shape.")
+
+    if volume.dtype == np.bool_:
+        volume = volume.view(np.uint8)
+    elif volume.dtype.newbyteorder("=") not in _NATIVE_TYPES:
+        volume = volume.astype(np.float64)
+    if step_size > 1:
+        volume = volume[::step_size, ::step_size, ::step_size]
+        if mask is not None:
+            mask = mask[::step_size, ::step_size, ::step_size]
+    volume = _volume(volume)
+
+    lo, hi = volume.min(), volume.max()
+    if level is None:
+        level = 0.5 * (float(lo) + float(hi))
+    else:
+        level = float(level)
+        if not np.isfinite(level):
+            raise ValueError(f"level: must be finite, got {level}")
+        if level < lo or level > hi:
+            raise ValueError("Surface level must be within volume data range.")
+
+    # The native call works in (x, y, z) with x fastest in memory: the array's axes reversed
+    # for a C-ordered array, as they are for a Fortran-ordered one.
+    c_order = volume.flags.c_contiguous
+    axes = [2, 1, 0] if c_order else [0, 1, 2]
+    xyz_spacing = tuple(spacing[a] * step_size for a in axes)
+    verts, faces, normals, _ = _native.extract(
+        volume, level, xyz_spacing, (0.0, 0.0, 0.0), "embedded", True, 0
+    )
+    if len(faces) == 0:
+        raise RuntimeError("No surface found at the given iso value.")
+    if c_order:
+        verts = verts[:, ::-1]
+        normals = normals[:, ::-1]
+    # Ours wind outward from `>= level` in (x, y, z). Reversing the axes of a C-ordered array is
+    # a reflection, which turns the winding round; scikit-image's 'descent' winds inward in the
+    # array's axes (negative signed volume), 'ascent' outward. Its normals point down the
+    # gradient either way, as ours do.
+    flip = c_order != (gradient_direction == "descent")
+    faces = faces.astype(np.int32)
+    if flip:
+        faces = faces[:, ::-1]
+
+    index = verts / np.asarray([s * step_size for s in spacing], dtype=np.float32)
+    if mask is not None:
+        faces = _masked(faces, index, mask)
+        verts, faces, normals, index = _compact(verts, faces, normals, index)
+        if len(faces) == 0:
+            raise RuntimeError("No surface found at the given iso value.")
+    values = _edge_values(volume, index)
+    return (
+        np.ascontiguousarray(verts),
+        np.ascontiguousarray(faces),
+        np.ascontiguousarray(normals),
+        values,
+    )
+
+
+def _masked(faces, index, mask):
+    """The faces whose centroid lies in a cube whose lower corner is True in ``mask``."""
+    centroid = index[faces].mean(axis=1)
+    cube = np.floor(centroid).astype(np.int64)
+    upper = np.asarray(mask.shape) - 2
+    cube = np.clip(cube, 0, upper)
+    return faces[mask[cube[:, 0], cube[:, 1], cube[:, 2]]]
+
+
+def _compact(verts, faces, normals, index):
+    """Drops vertices no face uses, renumbering the faces."""
+    used = np.zeros(len(verts), dtype=bool)
+    used[faces.ravel()] = True
+    new = np.cumsum(used) - 1
+    return verts[used], new[faces].astype(np.int32), normals[used], index[used]
+
+
+def _edge_values(volume, index):
+    """Per vertex, the larger sample at the ends of its grid edge.
+
+    A vertex lies on a grid edge strictly between its ends (at least 1/1024 away), so along one
+    axis its index coordinate is fractional and along the other two it is whole.
+    """
+    if len(index) == 0:
+        return np.zeros(0, np.float32)
+    rounded = np.rint(index)
+    axis = np.argmax(np.abs(index - rounded), axis=1)
+    lower = rounded.astype(np.int64)
+    rows = np.arange(len(index))
+    lower[rows, axis] = np.floor(index[rows, axis]).astype(np.int64)
+    upper = lower.copy()
+    upper[rows, axis] += 1
+    shape = np.asarray(volume.shape) - 1
+    lower = np.clip(lower, 0, shape)
+    upper = np.clip(upper, 0, shape)
+    a = volume[lower[:, 0], lower[:, 1], lower[:, 2]]
+    b = volume[upper[:, 0], upper[:, 1], upper[:, 2]]
+    return np.maximum(a, b).astype(np.float32)

@@ -1,0 +1,93 @@
+//! NumPy arrays to and from Rust without copying. A C-ordered array of shape `(a, b, c)` is read
+//! as `z, y, x` (x fastest in memory, `nx = c`), a Fortran-ordered one as `x, y, z`: either way the
+//! buffer is already the runtime's x-fastest layout, so it is borrowed as it is. This is the
+//! CLI's NumPy reader's convention.
+
+use numpy::{Element, PyArray1, PyArray2, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+/// The runtime's sample types, in the order error messages list them.
+pub const TYPES: &str = "uint8, int8, uint16, int16, uint32, int32, float32 or float64";
+
+/// Calls `$body` with `$t` bound to the Rust type of `$array`'s dtype, or returns a `TypeError`.
+macro_rules! with_element {
+    ($py:expr, $array:expr, $name:expr, $t:ident => $body:expr) => {{
+        let dtype = numpy::PyUntypedArrayMethods::dtype($array);
+        let is = |other| numpy::PyArrayDescrMethods::is_equiv_to(&dtype, &other);
+        if is(numpy::dtype::<u8>($py)) {
+            type $t = u8;
+            $body
+        } else if is(numpy::dtype::<i8>($py)) {
+            type $t = i8;
+            $body
+        } else if is(numpy::dtype::<u16>($py)) {
+            type $t = u16;
+            $body
+        } else if is(numpy::dtype::<i16>($py)) {
+            type $t = i16;
+            $body
+        } else if is(numpy::dtype::<u32>($py)) {
+            type $t = u32;
+            $body
+        } else if is(numpy::dtype::<i32>($py)) {
+            type $t = i32;
+            $body
+        } else if is(numpy::dtype::<f32>($py)) {
+            type $t = f32;
+            $body
+        } else if is(numpy::dtype::<f64>($py)) {
+            type $t = f64;
+            $body
+        } else {
+            Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "{}: unsupported dtype {}; use {}",
+                $name,
+                dtype,
+                $crate::convert::TYPES
+            )))
+        }
+    }};
+}
+pub(crate) use with_element;
+
+/// `[nx, ny, nz]` of a 3-D array whose buffer is contiguous in C or Fortran order.
+pub fn dims(array: &Bound<'_, PyUntypedArray>, name: &str) -> PyResult<[usize; 3]> {
+    let shape = array.shape();
+    let [a, b, c] = <[usize; 3]>::try_from(shape).map_err(|_| {
+        PyValueError::new_err(format!(
+            "{name}: expected a 3-D array, got {} dimensions",
+            shape.len()
+        ))
+    })?;
+    if array.is_c_contiguous() {
+        Ok([c, b, a])
+    } else if array.is_fortran_contiguous() {
+        Ok([a, b, c])
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{name}: the array is not contiguous; pass numpy.ascontiguousarray({name}) \
+             (skelclimb.extract does this for you, with one copy)"
+        )))
+    }
+}
+
+/// The samples of `array`, borrowed.
+pub fn samples<'a, T: Element>(
+    array: &'a Bound<'_, PyUntypedArray>,
+    name: &str,
+) -> PyResult<numpy::PyReadonlyArrayDyn<'a, T>> {
+    let typed = array
+        .cast::<numpy::PyArrayDyn<T>>()
+        .map_err(|_| PyTypeError::new_err(format!("{name}: dtype changed while reading")))?;
+    Ok(typed.readonly())
+}
+
+/// A `(n, 3)` NumPy array that takes over `rows` without copying them.
+pub fn rows<'py, T: Element>(
+    py: Python<'py>,
+    rows: Vec<[T; 3]>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let n = rows.len();
+    PyArray1::from_vec(py, rows.into_flattened()).reshape([n, 3])
+}

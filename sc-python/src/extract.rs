@@ -1,0 +1,141 @@
+//! `skelclimb._native.extract`: the whole extraction with the GIL released.
+
+use numpy::{Element, PyUntypedArray};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use sc_runtime::{Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
+
+use crate::convert::{self, with_element};
+use crate::errors;
+
+/// Parses a mode name as the CLI spells it.
+pub fn mode(name: &str) -> PyResult<Mode> {
+    match name {
+        "embedded" => Ok(Mode::Embedded),
+        "paper" => Ok(Mode::Paper),
+        "steps123" => Ok(Mode::Steps123),
+        _ => Err(PyValueError::new_err(format!(
+            "mode: expected 'embedded', 'paper' or 'steps123', got {name:?}"
+        ))),
+    }
+}
+
+/// Checks the numbers every front end takes and builds the runtime's parameters.
+pub fn params(
+    level: f64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    mode_name: &str,
+    normals: bool,
+) -> PyResult<Params> {
+    if !level.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "level: must be a finite number, got {level}"
+        )));
+    }
+    if !spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "spacing: must be three positive finite numbers, got {spacing:?}"
+        )));
+    }
+    if !origin.iter().all(|o| o.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "origin: must be three finite numbers, got {origin:?}"
+        )));
+    }
+    Ok(Params {
+        mode: mode(mode_name)?,
+        normals,
+        spacing,
+        origin,
+        ..Params::new(level)
+    })
+}
+
+/// Extracts the surface `volume = level` of a contiguous 3-D array (x fastest in memory; see
+/// `convert`). Returns `(vertices, faces, normals or None, stats)`.
+#[pyfunction]
+#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn extract<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, PyUntypedArray>,
+    level: f64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    mode: &str,
+    normals: bool,
+    threads: usize,
+) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    let params = params(level, spacing, origin, mode, normals)?;
+    let dims = convert::dims(volume, "volume")?;
+    let mesh =
+        with_element!(py, volume, "volume", T => run::<T>(py, volume, dims, &params, threads))?;
+    let stats = stats(py, &mesh.stats, mode, level, dims)?;
+    let Mesh {
+        positions,
+        normals: vertex_normals,
+        triangles,
+        ..
+    } = mesh;
+    let normals = if normals {
+        Some(convert::rows(py, vertex_normals)?)
+    } else {
+        None
+    };
+    (
+        convert::rows(py, positions)?,
+        convert::rows(py, triangles)?,
+        normals,
+        stats,
+    )
+        .into_pyobject(py)
+}
+
+fn run<T: Scalar + Element>(
+    py: Python<'_>,
+    volume: &Bound<'_, PyUntypedArray>,
+    dims: [usize; 3],
+    params: &Params,
+    threads: usize,
+) -> PyResult<Mesh> {
+    let samples = convert::samples::<T>(volume, "volume")?;
+    let data = samples
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("volume: the array is not contiguous"))?;
+    let volume = Volume::new(data, dims).map_err(errors::runtime)?;
+    py.detach(|| extract_par(&volume, params, threads, &|_| {}))
+        .map_err(errors::runtime)
+}
+
+/// The figures the CLI's `--stats-json` reports, as a dict.
+pub fn stats<'py>(
+    py: Python<'py>,
+    s: &Stats,
+    mode: &str,
+    level: f64,
+    dims: [usize; 3],
+) -> PyResult<Bound<'py, PyDict>> {
+    let counts = |v: u64, t: u64| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("vertices", v)?;
+        d.set_item("triangles", t)?;
+        Ok(d)
+    };
+    let d = PyDict::new(py);
+    d.set_item("dims", dims)?;
+    d.set_item("iso", level)?;
+    d.set_item("mode", mode)?;
+    d.set_item("steps123", counts(s.v13, s.t13)?)?;
+    d.set_item("result", counts(s.vertices, s.triangles)?)?;
+    d.set_item("merged", s.merged)?;
+    d.set_item("blocked", s.blocked)?;
+    let reduction = if s.t13 == 0 {
+        0.0
+    } else {
+        100.0 * (1.0 - s.triangles as f64 / s.t13 as f64)
+    };
+    d.set_item("reduction_percent", reduction)?;
+    Ok(d)
+}

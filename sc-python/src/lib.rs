@@ -1,0 +1,20 @@
+//! The native half of the `skelclimb` Python package. It stays thin: arrays in and out without
+//! copies, the GIL released while the Rust extractor runs, errors as Python exceptions. The
+//! NumPy-facing conveniences (`marching_cubes`, `Mesh`) are Python, in `python/skelclimb`.
+
+mod convert;
+mod errors;
+mod extract;
+mod files;
+mod streamer;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(extract::extract, m)?)?;
+    m.add_function(wrap_pyfunction!(files::save, m)?)?;
+    m.add_function(wrap_pyfunction!(files::load, m)?)?;
+    m.add_class::<streamer::SliceStreamer>()?;
+    Ok(())
+}
