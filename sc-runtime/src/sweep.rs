@@ -197,7 +197,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let next = grid.row(n, y + 1);
                 let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
                 for_each_differing(row, next, start, end, |x| {
-                    let grey = x % 2 == 1 && n % 2 == 0;
+                    let grey = x % 2 == 1 && n.is_multiple_of(2);
                     let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
                     out.ids[ybase + y * nx + x] = id;
                     Ok(())
