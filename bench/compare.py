@@ -125,4 +125,5 @@ def main():
         print(f"| {g} ({tris:,}) | {fe1:.1f} | {s1:.1f} | {e1:.1f} | {p1:.1f} | **{e1 / fe1:.2f}×** | {e_all:.1f} | {e1 / e_all:.2f}× | {100 * (e1 / s1 - 1):+.0f}% |")
 
 
-main()
+if __name__ == "__main__":
+    main()

@@ -1,7 +1,6 @@
 """The Python package against the CLI, scikit-image, VTK and exact geometry."""
 
 import os
-import shutil
 import struct
 import subprocess
 import threading
@@ -52,12 +51,9 @@ def crop():
 
 
 def skelclimb_binary():
-    exe = shutil.which("skelclimb") or ROOT / "target" / "release" / "skelclimb"
-    if not Path(exe).exists():
-        subprocess.run(
-            ["cargo", "build", "--release", "-q", "-p", "sc-cli"], cwd=ROOT, check=True
-        )
-    return str(exe)
+    """This checkout's `skelclimb`, built if needed (never another one on the PATH)."""
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "sc-cli"], cwd=ROOT, check=True)
+    return str(ROOT / "target" / "release" / "skelclimb")
 
 
 def read_binary_ply(path):
@@ -397,3 +393,15 @@ def test_no_rust_panic_reaches_python():
             skelclimb.load(bad)
     finally:
         bad.unlink()
+
+
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_values_are_the_larger_sample_of_each_vertex_edge(order):
+    vol = np.asarray(np.random.default_rng(0).random((6, 7, 8), dtype=np.float32), order=order)
+    verts, _, _, values = skelclimb.marching_cubes(vol, 0.5)
+    lower = np.floor(verts).astype(int)
+    step = (verts != np.floor(verts)).astype(int)
+    assert (step.sum(axis=1) == 1).all()  # exactly one fractional coordinate per vertex
+    a, b = vol[tuple(lower.T)], vol[tuple((lower + step).T)]
+    assert np.array_equal(values, np.maximum(a, b))
+    assert ((np.minimum(a, b) < 0.5) & (np.maximum(a, b) >= 0.5)).all()

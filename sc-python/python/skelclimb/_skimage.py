@@ -24,6 +24,7 @@ def marching_cubes(
     allow_degenerate=True,
     method="lewiner",
     mask=None,
+    threads=0,
 ):
     """Skeleton Climbing with the signature and results of ``skimage.measure.marching_cubes``.
 
@@ -56,6 +57,8 @@ def marching_cubes(
     mask : (M, N, P) bool ndarray, optional
         Keep only triangles in cubes whose lower corner is True, as scikit-image does. A merged
         triangle spans two cubes and is kept when the cube holding its centroid is.
+    threads : int
+        Not in scikit-image: worker threads, 0 for all cores (the result is the same).
 
     Returns
     -------
@@ -114,7 +117,7 @@ def marching_cubes(
     axes = [2, 1, 0] if c_order else [0, 1, 2]
     xyz_spacing = tuple(spacing[a] * step_size for a in axes)
     verts, faces, normals, _ = _native.extract(
-        volume, level, xyz_spacing, (0.0, 0.0, 0.0), "embedded", True, 0
+        volume, level, xyz_spacing, (0.0, 0.0, 0.0), "embedded", True, int(threads)
     )
     if len(faces) == 0:
         raise RuntimeError("No surface found at the given iso value.")
@@ -165,21 +168,18 @@ def _compact(verts, faces, normals, index):
 def _edge_values(volume, index):
     """Per vertex, the larger sample at the ends of its grid edge.
 
-    A vertex lies on a grid edge strictly between its ends (at least 1/1024 away), so along one
-    axis its index coordinate is fractional and along the other two it is whole.
+    A vertex lies on a grid edge strictly between its ends (at least 1/1024 away), so one index
+    coordinate is fractional and the other two are whole: the lower end is the floor of all
+    three, the upper end one step further along the fractional axis.
     """
     if len(index) == 0:
         return np.zeros(0, np.float32)
-    rounded = np.rint(index)
-    axis = np.argmax(np.abs(index - rounded), axis=1)
-    lower = rounded.astype(np.int64)
-    rows = np.arange(len(index))
-    lower[rows, axis] = np.floor(index[rows, axis]).astype(np.int64)
-    upper = lower.copy()
-    upper[rows, axis] += 1
-    shape = np.asarray(volume.shape) - 1
-    lower = np.clip(lower, 0, shape)
-    upper = np.clip(upper, 0, shape)
-    a = volume[lower[:, 0], lower[:, 1], lower[:, 2]]
-    b = volume[upper[:, 0], upper[:, 1], upper[:, 2]]
+    lower = np.floor(index)
+    step = (index != lower).astype(np.int64)
+    lower = lower.astype(np.int64)
+    strides = np.asarray(volume.strides) // volume.itemsize
+    flat = volume.reshape(-1, order="A")
+    first = lower @ strides
+    a = flat[first]
+    b = flat[first + step @ strides]
     return np.maximum(a, b).astype(np.float32)

@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""`skelclimb.marching_cubes` against the Python meshers people use, in one run on the same data.
+
+Peers: scikit-image's `marching_cubes` (Lewiner), PyMCubes, zmesh (on the thresholded mask: it
+meshes labels, so its vertices sit on half-integer positions and are not interpolated) and VTK's
+`vtkFlyingEdges3D` called through NumPy (with normals, as skelclimb and scikit-image return them;
+PyMCubes and zmesh here return none). Every time is the median of --repeat runs of the whole
+call, conversions from and to NumPy included, on one thread (VTK's SMP tools set to 1, skelclimb
+with threads=1). Volumes: the built-in 256³ sphere, knot and noisy sphere (as bench/compare.py
+builds them), and the raw + JSON volumes of SC_DATA_DIR at their suggested iso values.
+
+    python3 -m venv target/bench-venv
+    target/bench-venv/bin/pip install ./sc-python scikit-image PyMCubes zmesh vtk
+    SC_DATA_DIR=../shared/data target/bench-venv/bin/python bench/python_compare.py
+"""
+import argparse
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare import BUILTIN, DTYPES  # noqa: E402  (the same generators as the Rust benchmarks)
+
+import mcubes  # noqa: E402
+import skimage  # noqa: E402
+import skimage.measure  # noqa: E402
+import vtk  # noqa: E402
+import zmesh  # noqa: E402
+from vtk.util import numpy_support  # noqa: E402
+
+import skelclimb  # noqa: E402
+
+DTYPES = dict(DTYPES, f32=np.float32, f64=np.float64, i8=np.int8, u32=np.uint32, i32=np.int32)
+
+
+def volumes(data_dir):
+    for name, (make, iso) in BUILTIN.items():
+        yield name, make(256).astype(np.float32), iso
+    if not data_dir:
+        print("SC_DATA_DIR not set: the real volumes are skipped", file=sys.stderr)
+        return
+    for name in sorted(os.listdir(data_dir)):
+        meta_path = os.path.join(data_dir, name, name + ".json")
+        if not os.path.exists(meta_path):
+            continue
+        meta = json.load(open(meta_path))
+        nx, ny, nz = meta["dims"]
+        raw = np.fromfile(os.path.join(data_dir, name, name + ".raw"), dtype=DTYPES[meta["dtype"]])
+        for label, iso in meta.get("iso_suggestions", {}).items():
+            if isinstance(iso, (int, float)):
+                yield f"{name}@{iso} ({label})", raw.reshape(nz, ny, nx), float(iso)
+
+
+def flying_edges(vol, iso):
+    image = vtk.vtkImageData()
+    nz, ny, nx = vol.shape
+    image.SetDimensions(nx, ny, nz)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(vol.ravel(), deep=False))
+    fe = vtk.vtkFlyingEdges3D()
+    fe.SetInputData(image)
+    fe.SetValue(0, iso)
+    fe.ComputeNormalsOn()  # like skelclimb and scikit-image, which return normals
+    fe.ComputeGradientsOff()
+    fe.ComputeScalarsOff()
+    fe.Update()
+    out = fe.GetOutput()
+    verts = numpy_support.vtk_to_numpy(out.GetPoints().GetData())
+    faces = numpy_support.vtk_to_numpy(out.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    numpy_support.vtk_to_numpy(out.GetPointData().GetNormals())
+    return verts, faces
+
+
+def zmesh_mask(vol, iso):
+    mesher = zmesh.Mesher((1, 1, 1))
+    mesher.mesh((vol >= iso).astype(np.uint8))
+    mesh = mesher.get(1, normals=False)
+    mesher.clear()
+    return mesh.vertices, mesh.faces
+
+
+PEERS = {
+    "skelclimb": lambda v, iso: skelclimb.marching_cubes(v, iso, threads=1)[:2],
+    "scikit-image": lambda v, iso: skimage.measure.marching_cubes(v, iso)[:2],
+    "PyMCubes": lambda v, iso: mcubes.marching_cubes(v, iso),
+    "zmesh (mask)": zmesh_mask,
+    "VTK Flying Edges": flying_edges,
+}
+
+
+def timed(fn, vol, iso, repeat):
+    times, faces = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        _, faces = fn(vol, iso)
+        times.append(time.perf_counter() - start)
+    return 1000 * statistics.median(times), len(faces)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=5)
+    a = ap.parse_args()
+    vtk.vtkSMPTools().Initialize(1)
+    cpu = next(
+        (l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")),
+        platform.processor(),
+    )
+    print(f"Machine: {cpu}, {os.cpu_count()} threads; one thread per mesher; median of {a.repeat}")
+    print(f"scikit-image {skimage.__version__}, VTK {vtk.vtkVersion.GetVTKVersion()}, "
+          f"zmesh {getattr(zmesh, '__version__', '?')}\n")
+    names = list(PEERS)
+    print("| volume | " + " | ".join(f"{n} ms (triangles)" for n in names)
+          + " | skimage / ours | FE / ours |")
+    print("|---" * (len(names) + 3) + "|")
+    for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR")):
+        row = {n: timed(PEERS[n], vol, iso, a.repeat) for n in names}
+        ours = row["skelclimb"][0]
+        cells = " | ".join(f"{t:.1f} ({f:,})" for t, f in row.values())
+        print(f"| {label} | {cells} | {row['scikit-image'][0] / ours:.1f}× "
+              f"| {row['VTK Flying Edges'][0] / ours:.2f}× |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
