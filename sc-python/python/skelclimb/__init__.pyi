@@ -1,0 +1,77 @@
+from os import PathLike
+from typing import Any, Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_Mode = Literal["embedded", "paper", "steps123"]
+_Triple = Sequence[float]
+_Path = Union[str, PathLike]
+
+class Mesh:
+    vertices: npt.NDArray[np.float32]
+    faces: npt.NDArray[np.uint32]
+    normals: Optional[npt.NDArray[np.float32]]
+    stats: dict[str, Any]
+    def __init__(
+        self,
+        vertices: npt.NDArray[np.float32],
+        faces: npt.NDArray[np.uint32],
+        normals: Optional[npt.NDArray[np.float32]] = ...,
+        stats: Optional[dict[str, Any]] = ...,
+    ) -> None: ...
+    def save(self, path: _Path, *, ascii: bool = ...) -> None: ...
+    def to_trimesh(self) -> Any: ...
+    def to_pyvista(self) -> Any: ...
+
+def extract(
+    volume: npt.NDArray[Any],
+    level: float,
+    *,
+    spacing: _Triple = ...,
+    origin: _Triple = ...,
+    mode: _Mode = ...,
+    pad: bool = ...,
+    normals: bool = ...,
+    threads: int = ...,
+) -> Mesh: ...
+def marching_cubes(
+    volume: npt.NDArray[Any],
+    level: Optional[float] = ...,
+    *,
+    spacing: _Triple = ...,
+    gradient_direction: Literal["descent", "ascent"] = ...,
+    step_size: int = ...,
+    allow_degenerate: bool = ...,
+    method: Literal["lewiner", "lorensen"] = ...,
+    mask: Optional[npt.NDArray[np.bool_]] = ...,
+    threads: int = ...,
+) -> Tuple[
+    npt.NDArray[np.float32],
+    npt.NDArray[np.int32],
+    npt.NDArray[np.float32],
+    npt.NDArray[np.float32],
+]: ...
+def load(
+    path: _Path,
+    *,
+    dims: Optional[Sequence[int]] = ...,
+    dtype: Optional[str] = ...,
+    endian: Literal["little", "big"] = ...,
+    header_bytes: int = ...,
+    array: Optional[str] = ...,
+) -> Tuple[npt.NDArray[Any], Tuple[float, float, float], Tuple[float, float, float]]: ...
+
+class SliceStreamer:
+    def __init__(
+        self,
+        shape: Sequence[int],
+        level: float,
+        *,
+        spacing: _Triple = ...,
+        origin: _Triple = ...,
+        mode: _Mode = ...,
+        normals: bool = ...,
+    ) -> None: ...
+    def push(self, slice: npt.NDArray[Any]) -> None: ...
+    def finish(self) -> Mesh: ...
