@@ -14,6 +14,7 @@ builds them), and the raw + JSON volumes of SC_DATA_DIR at their suggested iso v
     SC_DATA_DIR=../shared/data target/bench-venv/bin/python bench/python_compare.py
 """
 import argparse
+import importlib.metadata
 import json
 import os
 import platform
@@ -112,7 +113,7 @@ def main():
     )
     print(f"Machine: {cpu}, {os.cpu_count()} threads; one thread per mesher; median of {a.repeat}")
     print(f"scikit-image {skimage.__version__}, VTK {vtk.vtkVersion.GetVTKVersion()}, "
-          f"zmesh {getattr(zmesh, '__version__', '?')}\n")
+          f"zmesh {importlib.metadata.version('zmesh')}\n")
     names = list(PEERS)
     print("| volume | " + " | ".join(f"{n} ms (triangles)" for n in names)
           + " | scikit-image / ours | ours / FE |")

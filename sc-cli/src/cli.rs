@@ -114,12 +114,9 @@ pub struct ExtractArgs {
     /// Surround the volume with one layer of empty samples, so that every surface is closed.
     #[arg(long)]
     pub pad: bool,
-    /// Distance between samples along x, y, z, overriding the file's.
-    #[arg(long, value_parser = parse_spacing)]
-    pub spacing: Option<[f64; 3]>,
-    /// World position of the first sample, overriding the file's.
-    #[arg(long, value_parser = parse_triple, allow_negative_numbers = true)]
-    pub origin: Option<[f64; 3]>,
+    /// Where the samples are.
+    #[command(flatten)]
+    pub placement: Placement,
     /// Also write the summary as JSON to this file.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
@@ -135,11 +132,37 @@ pub struct ExtractArgs {
     pub read: InputArgs,
 }
 
+/// Overrides of where the file says its samples are.
+#[derive(Debug, Args)]
+pub struct Placement {
+    /// Distance between samples along x, y, z, overriding the file's.
+    #[arg(long, value_parser = parse_spacing)]
+    pub spacing: Option<[f64; 3]>,
+    /// World position of the first sample, overriding the file's.
+    #[arg(long, value_parser = parse_triple, allow_hyphen_values = true)]
+    pub origin: Option<[f64; 3]>,
+}
+
+impl Placement {
+    /// Applies the overrides to `grid`.
+    pub fn apply(&self, grid: &mut sc_io::volume::Grid) {
+        if let Some(spacing) = self.spacing {
+            grid.spacing = spacing;
+        }
+        if let Some(origin) = self.origin {
+            grid.origin = origin;
+        }
+    }
+}
+
 /// Arguments of `info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
     /// The volume (any format `extract` reads).
     pub input: PathBuf,
+    /// Where the samples are.
+    #[command(flatten)]
+    pub placement: Placement,
     /// Histogram bins to print.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=256))]
     pub bins: u16,

@@ -60,3 +60,29 @@ impl Progress for Bar {
         }
     }
 }
+
+/// A writer that reports the bytes passing through it, so that writing a large mesh shows
+/// progress like reading and meshing do.
+pub struct Counted<'a, W> {
+    inner: W,
+    progress: &'a dyn Progress,
+}
+
+impl<'a, W: std::io::Write> Counted<'a, W> {
+    /// Counts what goes to `inner` into `progress`.
+    pub fn new(inner: W, progress: &'a dyn Progress) -> Self {
+        Counted { inner, progress }
+    }
+}
+
+impl<W: std::io::Write> std::io::Write for Counted<'_, W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.progress.inc(n as u64);
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}

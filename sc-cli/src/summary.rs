@@ -18,8 +18,10 @@ pub struct Summary {
     pub input: String,
     /// Its format.
     pub format: &'static str,
-    /// `[nx, ny, nz]` as meshed (after `--pad`).
+    /// `[nx, ny, nz]` of the input.
     pub dims: [usize; 3],
+    /// Whether `--pad` added a layer of empty samples on every side before meshing.
+    pub padded: bool,
     /// Sample type name.
     pub dtype: &'static str,
     /// Surface value.
@@ -79,6 +81,7 @@ impl Summary {
             "input": self.input,
             "format": self.format,
             "dims": self.dims,
+            "padded": self.padded,
             "dtype": self.dtype,
             "iso": self.iso,
             "mode": format!("{:?}", self.mode).to_lowercase(),
@@ -110,6 +113,15 @@ impl fmt::Display for Summary {
             "  dims {nx} × {ny} × {nz}, {}, iso {}",
             self.dtype, self.iso
         )?;
+        if self.padded {
+            writeln!(
+                f,
+                "  --pad: meshed as {} × {} × {}, one layer of empty samples added on every side",
+                nx + 2,
+                ny + 2,
+                nz + 2
+            )?;
+        }
         writeln!(f, "  {:<22}{:>12}{:>12}", "", "vertices", "triangles")?;
         writeln!(
             f,
@@ -188,6 +200,7 @@ mod tests {
             input: "v.nii".into(),
             format: "NIfTI-1",
             dims: [4, 5, 6],
+            padded: true,
             dtype: "u8",
             iso: 20.0,
             mode: Mode::Embedded,
@@ -203,9 +216,12 @@ mod tests {
             text.contains("4 × 5 × 6") && text.contains("25.0 % fewer"),
             "{text}"
         );
+        assert!(text.contains("--pad: meshed as 6 × 7 × 8"), "{text}");
         let j = s.to_json();
         assert_eq!(j["result"]["triangles"], 12);
         assert_eq!(j["mode"], "embedded");
+        assert_eq!(j["padded"], true);
+        assert_eq!(j["dims"], serde_json::json!([4, 5, 6]));
         assert_eq!(j["reduction_percent"], 25.0);
     }
 }

@@ -88,3 +88,16 @@ fn a_bad_sidecar_names_the_file_and_field() {
             "v.raw: the file has 8 bytes, but dims 2,2,3 of u8",
         ));
 }
+
+#[test]
+fn info_takes_spacing_and_origin_overrides() {
+    Command::cargo_bin("skelclimb")
+        .unwrap()
+        .arg("info")
+        .arg(fixture("itk-t1-crop-40x40x30.i16.json"))
+        .args(["--spacing", "0.5,0.5,1.25", "--origin", "-3,0,7"])
+        .assert()
+        .success()
+        .stdout(contains("spacing   0.5 × 0.5 × 1.25"))
+        .stdout(contains("origin    -3, 0, 7"));
+}

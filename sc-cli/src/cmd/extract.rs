@@ -9,10 +9,11 @@ use super::warn;
 use crate::builtin;
 use crate::check::EdgeReport;
 use crate::cli::{Demo, ExtractArgs, ModeArg};
-use crate::progress::Bar;
+use crate::progress::{Bar, Counted};
 use crate::summary::Summary;
 use sc_io::atomic::AtomicFile;
 use sc_io::error::{Error, Result};
+use sc_io::progress::Progress;
 use sc_io::read::{self, Format};
 use sc_io::surface::{self, Request};
 use sc_io::write::MeshFormat;
@@ -66,34 +67,28 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         (None, None) => return Err(Error::Usage("give an input volume or --demo".into())),
     };
     let read_time = clock.elapsed();
-    if let Some(spacing) = args.spacing {
-        grid.spacing = spacing;
-    }
-    if let Some(origin) = args.origin {
-        grid.origin = origin;
-    }
+    let file_dims = grid.dims;
+    args.placement.apply(&mut grid);
     if args.pad {
         grid.pad(iso).map_err(|e| Error::file(&input, e))?;
     }
 
     let clock = Instant::now();
-    let range = grid.range();
-    let mesh = match surface::why_empty(&range, iso) {
-        Some(why) => {
-            warn(format!("{input}: {why}; writing an empty mesh"));
-            Mesh::default()
-        }
-        None => {
-            let request = Request {
-                iso,
-                mode: args.mode.into(),
-                normals: !args.no_normals,
-                threads: args.threads,
-            };
-            surface::extract(&grid, &request, &progress)?
-        }
+    let request = Request {
+        iso,
+        mode: args.mode.into(),
+        normals: !args.no_normals,
+        threads: args.threads,
     };
+    let mesh = surface::extract(&grid, &request, &progress)?;
     let extract_time = clock.elapsed();
+    // The value range is only needed to explain an empty mesh, so the pass over every sample
+    // is made only then.
+    if mesh.triangles.is_empty() {
+        let why = surface::why_empty(&grid.range(), iso)
+            .unwrap_or_else(|| "no sample is on both sides of the iso value".into());
+        warn(format!("{input}: {why}; writing an empty mesh"));
+    }
     let is_paper_knot =
         args.demo == Some(Demo::Knot) && args.size == 64 && args.iso.is_none_or(|i| i == iso);
     let paper_knot = match args.mode {
@@ -113,14 +108,22 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             )
         }
     };
-    progress.finish();
 
     let clock = Instant::now();
-    mesh_file.write_with(|out| args.output.format.write(&mesh, args.ascii, out))?;
+    progress.phase(
+        "writing",
+        approx_bytes(&mesh, args.output.format, args.ascii),
+    );
+    mesh_file.write_with(|out| {
+        let mut counted = Counted::new(out, &progress);
+        args.output.format.write(&mesh, args.ascii, &mut counted)
+    })?;
+    progress.finish();
     let summary = Summary {
         input,
         format: grid.format,
-        dims: grid.dims,
+        dims: file_dims,
+        padded: args.pad,
         dtype: grid.samples.dtype().name(),
         iso,
         mode: args.mode.into(),
@@ -139,4 +142,19 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         println!("{summary}");
     }
     Ok(())
+}
+
+/// About how many bytes `format` writes for `mesh`, for the progress bar: exact for binary PLY
+/// and STL up to the header, a fair guess for the text formats.
+fn approx_bytes(mesh: &Mesh, format: MeshFormat, ascii: bool) -> u64 {
+    let v = mesh.positions.len() as u64;
+    let n = mesh.normals.len() as u64;
+    let t = mesh.triangles.len() as u64;
+    let binary = match format {
+        MeshFormat::Ply => 12 * (v + n) + 13 * t,
+        MeshFormat::Stl => 84 + 50 * t,
+        MeshFormat::Glb => 12 * (v + n) + 12 * t,
+        MeshFormat::Obj => 3 * (12 * (v + n) + 12 * t),
+    };
+    if ascii { 3 * binary } else { binary }
 }

@@ -16,7 +16,8 @@ const SUGGESTION_BINS: usize = 128;
 /// Prints what is known about the volume and which iso values to try.
 pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
-    let grid = read::read(&args.input, &args.read.read_options(), &progress)?;
+    let mut grid = read::read(&args.input, &args.read.read_options(), &progress)?;
+    args.placement.apply(&mut grid);
     progress.finish();
     print!(
         "{}",
