@@ -7,6 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use sc_runtime::Mode;
 
 use sc_io::read::{RawLayout, ReadOptions};
+use sc_io::space::Coordinates;
 use sc_io::volume::{Dtype, Endian};
 use sc_io::write::MeshFormat;
 
@@ -117,6 +118,12 @@ pub struct ExtractArgs {
     /// Where the samples are.
     #[command(flatten)]
     pub placement: Placement,
+    /// The mesh's coordinates: the scanner's world as the file states it (`native`: RAS for
+    /// NIfTI, LPS for DICOM, MetaImage and NRRD in LPS space), converted to `ras` or `lps`, or
+    /// `index` (index × spacing + origin, the file's rotation ignored). Files without a world
+    /// frame (raw, NumPy) always give index × spacing + origin.
+    #[arg(long, value_enum, default_value_t = Coordinates::Native)]
+    pub space: Coordinates,
     /// Also write the summary as JSON to this file.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,

@@ -22,6 +22,8 @@ pub struct Summary {
     pub dims: [usize; 3],
     /// Whether `--pad` added a layer of empty samples on every side before meshing.
     pub padded: bool,
+    /// The mesh's coordinate system, in words.
+    pub coordinates: String,
     /// Sample type name.
     pub dtype: &'static str,
     /// Surface value.
@@ -82,6 +84,7 @@ impl Summary {
             "format": self.format,
             "dims": self.dims,
             "padded": self.padded,
+            "coordinates": self.coordinates,
             "dtype": self.dtype,
             "iso": self.iso,
             "mode": format!("{:?}", self.mode).to_lowercase(),
@@ -113,6 +116,7 @@ impl fmt::Display for Summary {
             "  dims {nx} × {ny} × {nz}, {}, iso {}",
             self.dtype, self.iso
         )?;
+        writeln!(f, "  coordinates: {}", self.coordinates)?;
         if self.padded {
             writeln!(
                 f,
@@ -201,6 +205,7 @@ mod tests {
             format: "NIfTI-1",
             dims: [4, 5, 6],
             padded: true,
+            coordinates: "RAS world coordinates (scanner space)".into(),
             dtype: "u8",
             iso: 20.0,
             mode: Mode::Embedded,
@@ -221,6 +226,8 @@ mod tests {
         assert_eq!(j["result"]["triangles"], 12);
         assert_eq!(j["mode"], "embedded");
         assert_eq!(j["padded"], true);
+        assert_eq!(j["coordinates"], "RAS world coordinates (scanner space)");
+        assert!(text.contains("coordinates: RAS world"), "{text}");
         assert_eq!(j["dims"], serde_json::json!([4, 5, 6]));
         assert_eq!(j["reduction_percent"], 25.0);
     }

@@ -17,6 +17,7 @@ pub mod atomic;
 pub mod error;
 pub mod progress;
 pub mod read;
+pub mod space;
 pub mod surface;
 pub mod volume;
 pub mod write;

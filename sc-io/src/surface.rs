@@ -4,6 +4,7 @@ use sc_runtime::{Mesh, Mode, Params, Volume, extract_par};
 
 use crate::error::Result;
 use crate::progress::Progress;
+use crate::space::{Coordinates, World};
 use crate::volume::{Grid, Range, Sample};
 use crate::with_samples;
 
@@ -18,6 +19,8 @@ pub struct Request {
     pub normals: bool,
     /// Worker threads, 0 for all cores.
     pub threads: usize,
+    /// Which coordinates the mesh is in.
+    pub coordinates: Coordinates,
 }
 
 impl Request {
@@ -28,19 +31,34 @@ impl Request {
             mode: Mode::Embedded,
             normals: true,
             threads: 0,
+            coordinates: Coordinates::Native,
         }
     }
 }
 
-/// Extracts the surface of `grid` in world units.
+/// The map from sample positions to the coordinates `request` asks for.
+pub fn world(grid: &Grid, request: &Request) -> World {
+    World::new(grid.frame, grid.origin, request.coordinates)
+}
+
+/// Extracts the surface of `grid` in world units: the scanner's world when the file places the
+/// volume in one (see [`crate::space`]), otherwise index × spacing + origin.
 pub fn extract(grid: &Grid, request: &Request, progress: &dyn Progress) -> Result<Mesh> {
+    let world = world(grid, request);
     let mut params = Params::new(grid.scale.invert(request.iso));
     params.mode = request.mode;
     params.normals = request.normals;
     params.spacing = grid.spacing;
-    params.origin = grid.origin;
+    if world.is_translation() {
+        params.origin = world.offset;
+    }
     progress.phase("meshing", grid.dims[2].saturating_sub(1) as u64);
-    with_samples!(&grid.samples, v => run(v, grid.dims, &params, request.threads, progress))
+    let mut mesh =
+        with_samples!(&grid.samples, v => run(v, grid.dims, &params, request.threads, progress))?;
+    if !world.is_translation() {
+        world.place(&mut mesh);
+    }
+    Ok(mesh)
 }
 
 fn run<T: Sample>(

@@ -4,6 +4,8 @@
 use bytemuck::Pod;
 use sc_runtime::Scalar;
 
+use crate::space::Frame;
+
 /// The sample types the extractor supports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
@@ -305,6 +307,9 @@ pub struct Grid {
     pub spacing: [f64; 3],
     /// World position of sample `(0, 0, 0)`.
     pub origin: [f64; 3],
+    /// The directions of the array's axes in the scanner's world, when the file states them:
+    /// sample `i` is at `origin + direction · (i ⊙ spacing)`.
+    pub frame: Option<Frame>,
     /// Stored-to-real value map.
     pub scale: Linear,
     /// The file format, for summaries.
@@ -321,6 +326,7 @@ impl Grid {
             dims,
             spacing: [1.0; 3],
             origin: [0.0; 3],
+            frame: None,
             scale: Linear::default(),
             format,
             notes: Vec::new(),
@@ -373,7 +379,15 @@ impl Grid {
             Sample::wrap(padded(v, dims, fill))
         });
         self.dims = dims.map(|d| d + 2);
-        self.origin = [0, 1, 2].map(|a| self.origin[a] - self.spacing[a]);
+        // One sample back along each axis, in world space.
+        let step = self.spacing;
+        let direction = self
+            .frame
+            .map_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], |f| {
+                f.direction
+            });
+        self.origin = [0, 1, 2]
+            .map(|r| self.origin[r] - (0..3).map(|a| direction[r][a] * step[a]).sum::<f64>());
         Ok(())
     }
 }

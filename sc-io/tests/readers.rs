@@ -64,15 +64,20 @@ fn nifti_gz_matches_the_reference() {
     assert_eq!(g.spacing, [2.0, 2.0, 3.0]);
     assert_eq!(checksums(&g), (19_533_798, 623_964_533_628));
     assert!(
-        g.notes.iter().any(|n| n.starts_with("sform (code 1)")),
+        g.notes
+            .iter()
+            .any(|n| n.starts_with("placed by the sform (code 1)")),
         "{:?}",
         g.notes
     );
-    assert!(
-        g.notes.iter().any(|n| n.starts_with("qform (code 2)")),
-        "{:?}",
-        g.notes
+    // sform rows [-2 0 0 -0] [0 0 3 -254] [0 2 0 0]: x runs to the right-to-left, y up, z back.
+    let frame = g.frame.unwrap();
+    assert_eq!(frame.space, sc_io::space::Space::Ras);
+    assert_eq!(
+        frame.direction,
+        [[-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
     );
+    assert_eq!(g.origin, [0.0, -254.0, 0.0]);
 }
 
 #[test]

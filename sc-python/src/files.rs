@@ -12,7 +12,7 @@ use sc_io::progress::Silent;
 use sc_io::read::{RawLayout, ReadOptions};
 use sc_io::volume::{Dtype, Endian, Grid, Linear, Sample, Samples};
 use sc_io::with_samples;
-use sc_io::write::MeshFormat;
+use sc_io::write::{MeshFormat, WriteOptions};
 use sc_runtime::Mesh;
 
 use crate::errors;
@@ -58,8 +58,11 @@ pub fn save(
         triangles,
         ..Mesh::default()
     };
-    py.detach(|| AtomicFile::create(&path)?.write_with(|out| format.write(&mesh, ascii, out)))
-        .map_err(errors::io)
+    py.detach(|| {
+        AtomicFile::create(&path)?
+            .write_with(|out| format.write(&mesh, &WriteOptions { ascii, space: None }, out))
+    })
+    .map_err(errors::io)
 }
 
 fn triples<T: numpy::Element + Copy>(

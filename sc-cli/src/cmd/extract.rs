@@ -16,7 +16,7 @@ use sc_io::error::{Error, Result};
 use sc_io::progress::Progress;
 use sc_io::read::{self, Format};
 use sc_io::surface::{self, Request};
-use sc_io::write::MeshFormat;
+use sc_io::write::{MeshFormat, WriteOptions};
 
 /// Reads, extracts, writes and reports. Output files are opened first, so that a bad output
 /// path fails before a long read, and written whole or not at all.
@@ -79,7 +79,9 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         mode: args.mode.into(),
         normals: !args.no_normals,
         threads: args.threads,
+        coordinates: args.space,
     };
+    let world = surface::world(&grid, &request);
     let mesh = surface::extract(&grid, &request, &progress)?;
     let extract_time = clock.elapsed();
     // The value range is only needed to explain an empty mesh, so the pass over every sample
@@ -96,10 +98,9 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         ModeArg::Paper => Some(mesh.stats.triangles),
         _ => {
             let request = Request {
-                iso,
                 mode: Mode::Paper,
                 normals: false,
-                threads: args.threads,
+                ..request
             };
             Some(
                 surface::extract(&grid, &request, &sc_io::progress::Silent)?
@@ -116,7 +117,11 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     );
     mesh_file.write_with(|out| {
         let mut counted = Counted::new(out, &progress);
-        args.output.format.write(&mesh, args.ascii, &mut counted)
+        let options = WriteOptions {
+            ascii: args.ascii,
+            space: world.space,
+        };
+        args.output.format.write(&mesh, &options, &mut counted)
     })?;
     progress.finish();
     let summary = Summary {
@@ -124,6 +129,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         format: grid.format,
         dims: file_dims,
         padded: args.pad,
+        coordinates: world.describe(),
         dtype: grid.samples.dtype().name(),
         iso,
         mode: args.mode.into(),

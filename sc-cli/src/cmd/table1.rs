@@ -79,10 +79,10 @@ fn row(label: &str, grid: &Grid, iso: f64, threads: usize, progress: &Bar) -> Re
     let mut cells = Vec::new();
     for mode in MODES {
         let request = Request {
-            iso,
             mode,
             normals: false,
             threads,
+            ..Request::new(iso)
         };
         // The best of three runs: the first also pays for page faults and thread start-up.
         let mut best = Duration::MAX;

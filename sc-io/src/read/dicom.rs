@@ -16,6 +16,7 @@ use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 
 use crate::error::{Error, Result, with_causes};
 use crate::progress::Progress;
+use crate::space::{Frame, Space};
 use crate::volume::{Dtype, Grid, Sample};
 use crate::with_dtype;
 
@@ -113,11 +114,16 @@ pub fn read(dir: &Path, progress: &dyn Progress) -> Result<Grid> {
             "slice gaps vary from {lo:.4} to {hi:.4}; the mesh uses their mean {dz:.4}"
         ));
     }
-    if o != [1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
-        grid.notes.push(format!(
-            "ImageOrientationPatient {o:?} (rotation not applied to the mesh)"
-        ));
-    }
+    // Rows run along the first direction cosine, columns along the second, and slices were
+    // sorted along their cross product: a right-handed frame in DICOM's LPS patient space.
+    let columns = [[o[0], o[1], o[2]], [o[3], o[4], o[5]], normal];
+    grid.frame = Some(
+        Frame::from_columns(columns, Space::Lps)
+            .ok_or_else(|| {
+                Error::file(dir, format!("ImageOrientationPatient {o:?} is degenerate"))
+            })?
+            .0,
+    );
     Ok(grid)
 }
 

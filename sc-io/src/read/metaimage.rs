@@ -10,6 +10,7 @@ use super::payload::{Encoding, Layout};
 use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
+use crate::space::{Frame, Space};
 use crate::volume::{Dtype, Endian, Grid};
 
 const SYNTAX: Syntax = Syntax {
@@ -86,14 +87,18 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
         let o = h.numbers::<f64>("Offset", o, 3)?;
         grid.origin = [o[0], o[1], o[2]];
     }
-    if let Some(m) = h.get_any(&["TransformMatrix", "Rotation", "Orientation"]) {
-        let m = h.numbers::<f64>("TransformMatrix", m, 9)?;
-        if m != [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] {
-            grid.notes.push(format!(
-                "TransformMatrix {m:?} (rotation not applied to the mesh)"
-            ));
+    // MetaImage is ITK's format: LPS world space, TransformMatrix listing each axis's direction
+    // in turn (three numbers per axis).
+    let columns = match h.get_any(&["TransformMatrix", "Rotation", "Orientation"]) {
+        Some(m) => {
+            let m = h.numbers::<f64>("TransformMatrix", m, 9)?;
+            [0, 1, 2].map(|a| [m[3 * a], m[3 * a + 1], m[3 * a + 2]])
         }
-    }
+        None => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    };
+    let (frame, _) = Frame::from_columns(columns, Space::Lps)
+        .ok_or_else(|| h.error("TransformMatrix is degenerate".to_string()))?;
+    grid.frame = Some(frame);
     Ok(grid)
 }
 

@@ -12,11 +12,12 @@ use super::payload::{Encoding, Layout};
 use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
+use crate::space::{Frame, Space};
 use crate::volume::{Dtype, Endian, Grid};
 
-/// Reads a NIfTI-1 volume. Spacing comes from pixdim; the origin from the sform translation, or
-/// the qform offset; scl_slope/scl_inter map stored values to real ones. Rotations in the
-/// affines are not applied to the mesh: `info` reports them.
+/// Reads a NIfTI-1 volume. The placement comes from the sform when its code is set, else from
+/// the qform, as the NIfTI standard orders them (spacing from pixdim with the qform);
+/// scl_slope/scl_inter map stored values to real ones.
 pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
     let gz = path.to_string_lossy().to_ascii_lowercase().ends_with(".gz");
     let encoding = if gz { Encoding::Gzip } else { Encoding::Raw };
@@ -74,29 +75,34 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
         grid.rescale(slope, f64::from(header.scl_inter));
     }
     if header.sform_code > 0 {
-        grid.origin = [header.srow_x[3], header.srow_y[3], header.srow_z[3]].map(f64::from);
-        let rows = [header.srow_x, header.srow_y, header.srow_z];
+        let rows = [header.srow_x, header.srow_y, header.srow_z].map(|r| r.map(f64::from));
+        let columns = [0, 1, 2].map(|a| [rows[0][a], rows[1][a], rows[2][a]]);
+        let (frame, spacing) = Frame::from_columns(columns, Space::Ras).ok_or_else(|| {
+            bad(format!(
+                "sform (code {}) is not a valid placement: its rows are {:?}",
+                header.sform_code, rows
+            ))
+        })?;
+        grid.frame = Some(frame);
+        grid.spacing = spacing;
+        grid.origin = [rows[0][3], rows[1][3], rows[2][3]];
         grid.notes.push(format!(
-            "sform (code {}): {} (origin taken from it; rotation and axis flips not applied)",
-            header.sform_code,
-            rows.map(|r| format!("[{} {} {} {}]", r[0], r[1], r[2], r[3]))
-                .join(" ")
+            "placed by the sform (code {}): RAS world coordinates",
+            header.sform_code
         ));
-    }
-    if header.qform_code > 0 {
-        if header.sform_code <= 0 {
-            grid.origin = [header.quatern_x, header.quatern_y, header.quatern_z].map(f64::from);
-        }
+    } else if header.qform_code > 0 {
+        let qfac = if header.pixdim[0] < 0.0 { -1.0 } else { 1.0 };
+        let [b, c, d] = [header.quatern_b, header.quatern_c, header.quatern_d].map(f64::from);
+        let frame = Frame::from_quaternion(b, c, d, qfac).ok_or_else(|| {
+            bad(format!(
+                "qform quaternion b, c, d = {b}, {c}, {d} is not a rotation"
+            ))
+        })?;
+        grid.frame = Some(frame);
+        grid.origin = [header.quatern_x, header.quatern_y, header.quatern_z].map(f64::from);
         grid.notes.push(format!(
-            "qform (code {}): quaternion b,c,d = {}, {}, {}, offset {}, {}, {}, qfac {}",
-            header.qform_code,
-            header.quatern_b,
-            header.quatern_c,
-            header.quatern_d,
-            header.quatern_x,
-            header.quatern_y,
-            header.quatern_z,
-            if header.pixdim[0] < 0.0 { -1 } else { 1 }
+            "placed by the qform (code {}, qfac {qfac}): RAS world coordinates",
+            header.qform_code
         ));
     }
     Ok(grid)

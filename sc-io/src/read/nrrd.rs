@@ -10,6 +10,7 @@ use super::payload::{Encoding, Layout};
 use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
+use crate::space::{Frame, Space};
 use crate::volume::{Dtype, Endian, Grid};
 
 const SYNTAX: Syntax = Syntax {
@@ -119,39 +120,43 @@ fn dtype(h: &TextHeader) -> Result<Dtype> {
 }
 
 /// Spacing from `space directions` (the vectors' lengths) or `spacings`, origin from
-/// `space origin`. The mesh is not rotated: a non-diagonal direction matrix becomes a note.
+/// `space origin`; with a `space` of LPS or RAS the directions place the volume in that world.
 fn place(h: &TextHeader, grid: &mut Grid) -> Result<()> {
+    let space = match h.get("space") {
+        Some("left-posterior-superior" | "LPS") => Some(Space::Lps),
+        Some("right-anterior-superior" | "RAS") => Some(Space::Ras),
+        Some(other) => {
+            grid.notes.push(format!(
+                "space {other}: not RAS or LPS, so the mesh is in index × spacing + origin"
+            ));
+            None
+        }
+        None => None,
+    };
     match h.get("space directions") {
         Some(dirs) if dirs != "none" => {
             let v = h.numbers::<f64>("space directions", dirs, 9)?;
-            for a in 0..3 {
-                let axis = &v[3 * a..3 * a + 3];
-                grid.spacing[a] = axis.iter().map(|c| c * c).sum::<f64>().sqrt();
-                if axis
-                    .iter()
-                    .enumerate()
-                    .any(|(b, c)| (b != a && *c != 0.0) || (b == a && *c < 0.0))
-                {
-                    grid.notes.push(format!(
-                        "space directions {dirs} (rotation not applied to the mesh)"
-                    ));
-                    break;
-                }
-            }
+            let columns = [0, 1, 2].map(|a| [v[3 * a], v[3 * a + 1], v[3 * a + 2]]);
+            let (frame, spacing) = Frame::from_columns(columns, space.unwrap_or(Space::Lps))
+                .ok_or_else(|| {
+                    h.error(format!(
+                        "space directions {dirs} do not span three dimensions"
+                    ))
+                })?;
+            grid.spacing = spacing;
+            grid.frame = space.map(|_| frame);
         }
         _ => {
             if let Some(s) = h.get("spacings") {
                 let s = h.numbers::<f64>("spacings", s, 3)?;
                 grid.spacing = [s[0], s[1], s[2]].map(|x| if x.is_finite() { x } else { 1.0 });
             }
+            grid.frame = space.map(Frame::aligned);
         }
     }
     if let Some(o) = h.get("space origin") {
         let o = h.numbers::<f64>("space origin", o, 3)?;
         grid.origin = [o[0], o[1], o[2]];
-    }
-    if let Some(space) = h.get("space") {
-        grid.notes.push(format!("space {space}"));
     }
     Ok(())
 }

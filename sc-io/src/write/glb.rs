@@ -7,6 +7,9 @@
 use std::io::{self, Write};
 
 use sc_runtime::Mesh;
+
+use super::WriteOptions;
+use crate::space::Space;
 use serde_json::{Value, json};
 
 const ARRAY_BUFFER: u32 = 34962;
@@ -16,14 +19,14 @@ const UNSIGNED_INT: u32 = 5125;
 const TRIANGLES: u32 = 4;
 
 /// Writes the GLB header, the JSON chunk and the binary chunk.
-pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
     let too_big = || {
         io::Error::new(
             io::ErrorKind::InvalidInput,
             "the mesh is too large for one GLB file",
         )
     };
-    let (json, bin_len) = document(mesh);
+    let (json, bin_len) = document(mesh, options);
     let mut json = serde_json::to_vec(&json).map_err(io::Error::other)?;
     json.resize(json.len().next_multiple_of(4), b' ');
     let total = 12 + 8 + json.len() + if bin_len > 0 { 8 + bin_len } else { 0 };
@@ -49,8 +52,12 @@ pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
 }
 
 /// The JSON document and the binary chunk's length (a multiple of 4, as every part is).
-fn document(mesh: &Mesh) -> (Value, usize) {
-    let asset = json!({ "version": "2.0", "generator": "skelclimb (Skeleton Climbing)" });
+fn document(mesh: &Mesh, options: &WriteOptions) -> (Value, usize) {
+    let asset = json!({
+        "version": "2.0",
+        "generator": "skelclimb (Skeleton Climbing)",
+        "extras": { "coordinates": options.coordinates() },
+    });
     if mesh.triangles.is_empty() {
         return (
             json!({ "asset": asset, "scene": 0, "scenes": [{ "nodes": [] }] }),
@@ -93,7 +100,7 @@ fn document(mesh: &Mesh) -> (Value, usize) {
         "asset": asset,
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
-        "nodes": [{ "mesh": 0, "name": "isosurface" }],
+        "nodes": [node(options)],
         "meshes": [{ "primitives": [{
             "attributes": attributes, "indices": accessors.len() - 1, "mode": TRIANGLES,
         }] }],
@@ -104,6 +111,26 @@ fn document(mesh: &Mesh) -> (Value, usize) {
     (doc, bin_len)
 }
 
+/// The mesh's node. glTF is in metres with +Y up and viewers look down −Z; scanner coordinates
+/// are millimetres with +Z superior. For those, the node scales by 1/1000 and turns the patient
+/// upright, facing the viewer (anterior towards +Z), leaving the vertex data exact.
+fn node(options: &WriteOptions) -> Value {
+    // Column-major 4×4 matrices: glTF (x, y, z) = (−x, z, y) from RAS, (x, z, −y) from LPS.
+    let matrix: Option<[f64; 16]> = match options.space {
+        Some(Space::Ras) => Some([
+            -0.001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.001, 0.0, 0.0, 0.001, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        ]),
+        Some(Space::Lps) => Some([
+            0.001, 0.0, 0.0, 0.0, 0.0, 0.0, -0.001, 0.0, 0.0, 0.001, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        ]),
+        None => None,
+    };
+    match matrix {
+        Some(m) => json!({ "mesh": 0, "name": "isosurface", "matrix": m }),
+        None => json!({ "mesh": 0, "name": "isosurface" }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,7 +138,7 @@ mod tests {
 
     fn glb(mesh: &Mesh) -> Vec<u8> {
         let mut bytes = Vec::new();
-        write(mesh, &mut bytes).unwrap();
+        write(mesh, &WriteOptions::default(), &mut bytes).unwrap();
         assert_eq!(bytes.len() % 4, 0);
         assert_eq!(
             u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,

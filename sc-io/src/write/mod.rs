@@ -11,6 +11,27 @@ use std::path::Path;
 
 use sc_runtime::Mesh;
 
+use crate::space::Space;
+
+/// How to write, and what to record in the file besides the mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// Text PLY instead of binary (the other formats have one encoding here).
+    pub ascii: bool,
+    /// The world convention of the vertices (millimetres), or `None` for index coordinates.
+    pub space: Option<Space>,
+}
+
+impl WriteOptions {
+    /// The coordinate system in words, for file comments.
+    pub fn coordinates(&self) -> String {
+        match self.space {
+            Some(space) => format!("{} world coordinates, millimetres", space.name()),
+            None => "index × spacing + origin".into(),
+        }
+    }
+}
+
 /// The mesh formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MeshFormat {
@@ -42,14 +63,19 @@ impl MeshFormat {
         }
     }
 
-    /// Writes `mesh`. `ascii` selects text PLY; the other formats have one encoding here.
-    pub fn write(self, mesh: &Mesh, ascii: bool, out: &mut impl Write) -> io::Result<()> {
+    /// Writes `mesh`, recording its coordinate system where the format has room for it.
+    pub fn write(
+        self,
+        mesh: &Mesh,
+        options: &WriteOptions,
+        out: &mut impl Write,
+    ) -> io::Result<()> {
         match self {
-            MeshFormat::Ply if ascii => ply::write_ascii(mesh, out),
-            MeshFormat::Ply => ply::write_binary(mesh, out),
-            MeshFormat::Obj => obj::write(mesh, out),
+            MeshFormat::Ply if options.ascii => ply::write_ascii(mesh, options, out),
+            MeshFormat::Ply => ply::write_binary(mesh, options, out),
+            MeshFormat::Obj => obj::write(mesh, options, out),
             MeshFormat::Stl => stl::write(mesh, out),
-            MeshFormat::Glb => glb::write(mesh, out),
+            MeshFormat::Glb => glb::write(mesh, options, out),
         }
     }
 }

@@ -4,13 +4,16 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
+use super::WriteOptions;
+
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.
-pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
     writeln!(
         out,
-        "# skelclimb (Skeleton Climbing): {} vertices, {} triangles",
+        "# skelclimb (Skeleton Climbing): {} vertices, {} triangles\n# coordinates: {}",
         mesh.positions.len(),
-        mesh.triangles.len()
+        mesh.triangles.len(),
+        options.coordinates()
     )?;
     for [x, y, z] in &mesh.positions {
         writeln!(out, "v {x} {y} {z}")?;
@@ -52,7 +55,7 @@ mod tests {
     fn round_trips_through_tobj() {
         let mesh = tetrahedron();
         let mut bytes = Vec::new();
-        write(&mesh, &mut bytes).unwrap();
+        write(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         // tobj renumbers vertices in order of first use: compare what each corner points at.
         assert_eq!(back.positions.len(), 3 * mesh.positions.len());
@@ -69,7 +72,7 @@ mod tests {
         let mut mesh = tetrahedron();
         mesh.normals.clear();
         let mut bytes = Vec::new();
-        write(&mesh, &mut bytes).unwrap();
+        write(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.normals.is_empty());
         assert_eq!(back.indices.len(), 12);

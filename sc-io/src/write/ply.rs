@@ -4,10 +4,18 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
-fn header(mesh: &Mesh, format: &str, out: &mut impl Write) -> io::Result<()> {
+use super::WriteOptions;
+
+fn header(
+    mesh: &Mesh,
+    format: &str,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
     writeln!(
         out,
-        "ply\nformat {format} 1.0\ncomment skelclimb (Skeleton Climbing)"
+        "ply\nformat {format} 1.0\ncomment skelclimb (Skeleton Climbing)\ncomment coordinates: {}",
+        options.coordinates()
     )?;
     writeln!(out, "element vertex {}", mesh.positions.len())?;
     writeln!(out, "property float x\nproperty float y\nproperty float z")?;
@@ -24,8 +32,8 @@ fn header(mesh: &Mesh, format: &str, out: &mut impl Write) -> io::Result<()> {
 /// Binary little-endian PLY. Records are encoded into a buffer a few thousand at a time and
 /// written in one call each: writing them field by field through the `BufWriter` cost as much as
 /// a quarter of the whole extraction.
-pub fn write_binary(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
-    header(mesh, "binary_little_endian", out)?;
+pub fn write_binary(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+    header(mesh, "binary_little_endian", options, out)?;
     let with_normals = !mesh.normals.is_empty();
     let vertex_bytes = if with_normals { 24 } else { 12 };
     in_chunks(mesh.positions.len(), vertex_bytes, out, |i, rec| {
@@ -68,8 +76,8 @@ fn in_chunks(
 }
 
 /// ASCII PLY; floats are printed in their shortest exact form, so nothing is lost.
-pub fn write_ascii(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
-    header(mesh, "ascii", out)?;
+pub fn write_ascii(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+    header(mesh, "ascii", options, out)?;
     for (i, [x, y, z]) in mesh.positions.iter().enumerate() {
         match mesh.normals.get(i) {
             Some([a, b, c]) => writeln!(out, "{x} {y} {z} {a} {b} {c}")?,
@@ -122,7 +130,7 @@ mod tests {
     fn binary_round_trips() {
         let mesh = tetrahedron();
         let mut bytes = Vec::new();
-        write_binary(&mesh, &mut bytes).unwrap();
+        write_binary(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert_eq!(
             (back.positions, back.normals, back.triangles),
@@ -135,7 +143,7 @@ mod tests {
         let mut mesh = tetrahedron();
         mesh.normals.clear();
         let mut bytes = Vec::new();
-        write_ascii(&mesh, &mut bytes).unwrap();
+        write_ascii(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.normals.is_empty());
         assert_eq!(
@@ -147,7 +155,7 @@ mod tests {
     #[test]
     fn empty_mesh_is_a_valid_file() {
         let mut bytes = Vec::new();
-        write_binary(&Mesh::default(), &mut bytes).unwrap();
+        write_binary(&Mesh::default(), &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.positions.is_empty() && back.triangles.is_empty());
     }
