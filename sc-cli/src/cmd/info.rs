@@ -69,6 +69,25 @@ pub fn describe(name: &str, grid: &Grid, bins: usize) -> String {
         short(oy),
         short(oz)
     );
+    if let Some(frame) = grid.frame {
+        let d = frame.direction;
+        let axis = |a: usize| {
+            format!(
+                "({}, {}, {})",
+                short(d[0][a]),
+                short(d[1][a]),
+                short(d[2][a])
+            )
+        };
+        let _ = writeln!(
+            out,
+            "  axes      x → {}, y → {}, z → {} ({} world)",
+            axis(0),
+            axis(1),
+            axis(2),
+            frame.space.name()
+        );
+    }
     if range.finite == 0 {
         let _ = writeln!(
             out,
