@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sc_runtime::Mode;
 
+use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
 use sc_io::space::Coordinates;
 use sc_io::volume::{Dtype, Endian};
@@ -62,6 +63,14 @@ pub struct InputArgs {
     /// .npz input: the array to read (may be left out if there is only one).
     #[arg(long)]
     pub array: Option<String>,
+    /// DICOM input: the series to read when the directory holds several, by SeriesInstanceUID
+    /// or by its number in `skelclimb info`'s list.
+    #[arg(long, help_heading = "DICOM input")]
+    pub series: Option<String>,
+    /// DICOM input: resample a series with missing slices onto even spacing (linear
+    /// interpolation) instead of refusing it.
+    #[arg(long, help_heading = "DICOM input")]
+    pub resample_gaps: bool,
 }
 
 impl InputArgs {
@@ -79,6 +88,10 @@ impl InputArgs {
         ReadOptions {
             raw,
             array: self.array.clone(),
+            dicom: DicomOptions {
+                series: self.series.clone(),
+                resample_gaps: self.resample_gaps,
+            },
         }
     }
 }

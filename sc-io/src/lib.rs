@@ -3,13 +3,14 @@
 //! same bytes.
 //!
 //! ```no_run
-//! use sc_io::{progress::Silent, read, surface, write::MeshFormat, atomic::AtomicFile};
+//! use sc_io::{atomic::AtomicFile, progress::Silent, read, surface};
+//! use sc_io::write::{MeshFormat, WriteOptions};
 //!
 //! let grid = read::read("scan.nii.gz".as_ref(), &read::ReadOptions::default(), &Silent)?;
 //! let request = surface::Request::new(300.0);
 //! let mesh = surface::extract(&grid, &request, &Silent)?;
 //! AtomicFile::create("bone.ply".as_ref())?
-//!     .write_with(|out| MeshFormat::Ply.write(&mesh, false, out))?;
+//!     .write_with(|out| MeshFormat::Ply.write(&mesh, &WriteOptions::default(), out))?;
 //! # Ok::<(), sc_io::Error>(())
 //! ```
 

@@ -273,7 +273,7 @@ fn raw_with_header_bytes_and_big_endian() {
         &path,
         &ReadOptions {
             raw: Some(raw),
-            array: None,
+            ..Default::default()
         },
         &Silent,
     )

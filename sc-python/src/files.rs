@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use sc_io::atomic::AtomicFile;
 use sc_io::progress::Silent;
+use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
 use sc_io::volume::{Dtype, Endian, Grid, Linear, Sample, Samples};
 use sc_io::with_samples;
@@ -88,7 +89,8 @@ fn triples<T: numpy::Element + Copy>(
 /// of shape `(nz, ny, nx)`, spacing and origin as `(x, y, z)`. A rescale slope/intercept in the
 /// file is applied (to float32 for 8- and 16-bit samples, float64 otherwise).
 #[pyfunction]
-#[pyo3(signature = (path, *, dims=None, dtype=None, endian="little", header_bytes=0, array=None))]
+#[pyo3(signature = (path, *, dims=None, dtype=None, endian="little", header_bytes=0, array=None, series=None, resample_gaps=false))]
+#[allow(clippy::too_many_arguments)]
 pub fn load<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -97,6 +99,8 @@ pub fn load<'py>(
     endian: &str,
     header_bytes: u64,
     array: Option<String>,
+    series: Option<String>,
+    resample_gaps: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let raw = match (dims, dtype) {
         (Some(dims), Some(dtype)) => Some(RawLayout {
@@ -120,7 +124,14 @@ pub fn load<'py>(
             ));
         }
     };
-    let options = ReadOptions { raw, array };
+    let options = ReadOptions {
+        raw,
+        array,
+        dicom: DicomOptions {
+            series,
+            resample_gaps,
+        },
+    };
     let grid = py
         .detach(|| sc_io::read::read(&path, &options, &Silent))
         .map_err(errors::io)?;

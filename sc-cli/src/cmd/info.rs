@@ -8,6 +8,7 @@ use crate::progress::Bar;
 use crate::summary::thousands;
 use sc_io::error::Result;
 use sc_io::read;
+use sc_io::read::dicom::{self, SeriesInfo};
 use sc_io::volume::{Dtype, Grid, Range};
 
 /// Bins behind the suggestions: fine enough to separate tissues, coarse enough to smooth noise.
@@ -15,8 +16,16 @@ const SUGGESTION_BINS: usize = 128;
 
 /// Prints what is known about the volume and which iso values to try.
 pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
+    let options = args.read.read_options();
+    if args.input.is_dir() && options.dicom.series.is_none() {
+        let series = dicom::list_series(&args.input)?;
+        if series.len() > 1 {
+            print!("{}", list(&args.input.display().to_string(), &series));
+            return Ok(());
+        }
+    }
     let progress = Bar::new(!quiet);
-    let mut grid = read::read(&args.input, &args.read.read_options(), &progress)?;
+    let mut grid = read::read(&args.input, &options, &progress)?;
     args.placement.apply(&mut grid);
     progress.finish();
     print!(
@@ -28,6 +37,27 @@ pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
         )
     );
     Ok(())
+}
+
+/// The series of a DICOM directory that holds several, as text.
+pub fn list(name: &str, series: &[SeriesInfo]) -> String {
+    let mut out = format!(
+        "{name}\n  format    DICOM directory with {} series (choose one with --series N or UID)\n",
+        series.len()
+    );
+    for (i, s) in series.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  {:>2}. {} × {} × {} slices  {}  {}",
+            i + 1,
+            s.size[0],
+            s.size[1],
+            s.slices,
+            s.uid,
+            s.description
+        );
+    }
+    out
 }
 
 /// The report, as text.

@@ -17,13 +17,14 @@ use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
 use crate::error::{Error, Result, with_causes};
 use crate::progress::Progress;
 use crate::space::{Frame, Space};
-use crate::volume::{Dtype, Grid, Sample};
-use crate::with_dtype;
+use crate::volume::{Dtype, Grid, Sample, Samples};
+use crate::{with_dtype, with_samples};
 
 /// What pass one learns of a slice from its header, before any pixel is decoded.
 struct Slice {
     path: PathBuf,
     series: String,
+    description: String,
     size: [u32; 2],
     dtype: Dtype,
     orientation: [f64; 6],
@@ -34,8 +35,43 @@ struct Slice {
     depth: f64,
 }
 
-/// Reads the series in `dir`.
-pub fn read(dir: &Path, progress: &dyn Progress) -> Result<Grid> {
+/// How to read a DICOM directory.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct DicomOptions {
+    /// The series to read when the directory holds several: its SeriesInstanceUID, or its
+    /// number (from 1) in [`list_series`]'s order.
+    pub series: Option<String>,
+    /// Resample a series with missing slices onto even spacing instead of refusing it.
+    pub resample_gaps: bool,
+}
+
+/// One series found in a directory, for listings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SeriesInfo {
+    /// SeriesInstanceUID.
+    pub uid: String,
+    /// SeriesDescription, possibly empty.
+    pub description: String,
+    /// Slices found.
+    pub slices: usize,
+    /// Columns × rows of its first slice.
+    pub size: [u32; 2],
+}
+
+/// The series under `dir` (searched recursively), in the order of their first file's path.
+pub fn list_series(dir: &Path) -> Result<Vec<SeriesInfo>> {
+    Ok(group(headers(dir)?)
+        .into_iter()
+        .map(|slices| SeriesInfo {
+            uid: slices[0].series.clone(),
+            description: slices[0].description.clone(),
+            slices: slices.len(),
+            size: slices[0].size,
+        })
+        .collect())
+}
+
+fn headers(dir: &Path) -> Result<Vec<Slice>> {
     let mut slices = Vec::new();
     for path in dicom_files(dir)? {
         let obj = OpenFileOptions::new()
@@ -49,6 +85,80 @@ pub fn read(dir: &Path, progress: &dyn Progress) -> Result<Grid> {
             })?;
         slices.push(slice_header(path, &obj)?);
     }
+    Ok(slices)
+}
+
+/// Slices grouped by series, groups in the order of their first slice.
+fn group(slices: Vec<Slice>) -> Vec<Vec<Slice>> {
+    let mut groups: Vec<Vec<Slice>> = Vec::new();
+    for s in slices {
+        match groups.iter_mut().find(|g| g[0].series == s.series) {
+            Some(g) => g.push(s),
+            None => groups.push(vec![s]),
+        }
+    }
+    groups
+}
+
+/// Picks the series `options` asks for, or the only one.
+fn choose(dir: &Path, mut groups: Vec<Vec<Slice>>, wanted: Option<&str>) -> Result<Vec<Slice>> {
+    let listing = |groups: &[Vec<Slice>]| {
+        groups
+            .iter()
+            .enumerate()
+            .map(|(i, g)| {
+                format!(
+                    "\n  {}. {} ({} slices{}{})",
+                    i + 1,
+                    g[0].series,
+                    g.len(),
+                    if g[0].description.is_empty() {
+                        ""
+                    } else {
+                        ", "
+                    },
+                    g[0].description
+                )
+            })
+            .collect::<String>()
+    };
+    let index = match wanted {
+        None if groups.len() <= 1 => 0,
+        None => {
+            return Err(Error::file(
+                dir,
+                format!(
+                    "the directory holds {} series; choose one with --series UID or its number:{}",
+                    groups.len(),
+                    listing(&groups)
+                ),
+            ));
+        }
+        Some(w) => match groups.iter().position(|g| g[0].series == w) {
+            Some(i) => i,
+            None => match w.parse::<usize>() {
+                Ok(n) if (1..=groups.len()).contains(&n) => n - 1,
+                _ => {
+                    return Err(Error::file(
+                        dir,
+                        format!("no series {w:?} here; the series are:{}", listing(&groups)),
+                    ));
+                }
+            },
+        },
+    };
+    if groups.is_empty() {
+        return Err(Error::file(
+            dir,
+            "no DICOM files in this directory or below it",
+        ));
+    }
+    Ok(groups.swap_remove(index))
+}
+
+/// Reads the series in `dir` (or below it).
+pub fn read(dir: &Path, choice: &DicomOptions, progress: &dyn Progress) -> Result<Grid> {
+    let mut slices = choose(dir, group(headers(dir)?), choice.series.as_deref())?;
     let Some(first) = slices.first() else {
         return Err(Error::file(dir, "no DICOM files in this directory"));
     };
@@ -95,25 +205,34 @@ pub fn read(dir: &Path, progress: &dyn Progress) -> Result<Grid> {
         with_dtype!(dtype, T => decode_all::<T>(&slices, &options, progress).map(Sample::wrap))?;
 
     let mut grid = Grid::new(samples, dims, "DICOM series");
-    let gaps: Vec<f64> = slices.windows(2).map(|p| p[1].depth - p[0].depth).collect();
-    let dz = if gaps.is_empty() {
-        1.0
-    } else {
-        gaps.iter().sum::<f64>() / gaps.len() as f64
-    };
-    grid.spacing = [first.pixel_spacing[1], first.pixel_spacing[0], dz];
-    grid.origin = first.position;
     if same_rescale {
         grid.rescale(first.rescale[0], first.rescale[1]);
     }
-    let (lo, hi) = gaps.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), g| {
-        (lo.min(*g), hi.max(*g))
+    let depths: Vec<f64> = slices.iter().map(|s| s.depth).collect();
+    let spacing = even_spacing(dir, &slices, choice.resample_gaps)?;
+    if let Some((dz, true)) = spacing {
+        let resampled = resample(&grid, &depths, dz);
+        grid.notes.push(format!(
+            "slices resampled onto even spacing {dz:.4} ({} slices → {})",
+            depths.len(),
+            resampled.dims[2]
+        ));
+        grid.samples = resampled.samples;
+        grid.dims = resampled.dims;
+        grid.scale = resampled.scale;
+    }
+    let dz = spacing.map_or(1.0, |(dz, _)| dz);
+    let gaps = depths.windows(2).map(|p| p[1] - p[0]);
+    let (lo, hi) = gaps.fold((f64::INFINITY, 0.0f64), |(lo, hi), g| {
+        (lo.min(g), hi.max(g))
     });
-    if hi - lo > 0.01 * dz {
+    if matches!(spacing, Some((_, false))) && hi - lo > 0.01 * dz {
         grid.notes.push(format!(
             "slice gaps vary from {lo:.4} to {hi:.4}; the mesh uses their mean {dz:.4}"
         ));
     }
+    grid.spacing = [first.pixel_spacing[1], first.pixel_spacing[0], dz];
+    grid.origin = first.position;
     // Rows run along the first direction cosine, columns along the second, and slices were
     // sorted along their cross product: a right-handed frame in DICOM's LPS patient space.
     let columns = [[o[0], o[1], o[2]], [o[3], o[4], o[5]], normal];
@@ -127,21 +246,33 @@ pub fn read(dir: &Path, progress: &dyn Progress) -> Result<Grid> {
     Ok(grid)
 }
 
-/// Regular files that carry the DICOM preamble, in name order. Other files (DICOMDIR, notes,
-/// thumbnails) are common in exported series and are passed over.
+/// Regular files that carry the DICOM preamble, in path order, in `dir` and the folders below it
+/// (exports often nest `PATIENT/STUDY/SERIES/`; symbolic links to folders are not followed, so
+/// a loop cannot trap the search). A DICOMDIR index and other files (notes, thumbnails) are passed
+/// over: every slice is found by its own header.
 fn dicom_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    const MAX_DEPTH: usize = 8;
     let mut files = Vec::new();
-    for entry in entries {
-        let path = entry.map_err(|e| Error::io(dir, e))?.path();
-        let hidden = path
-            .file_name()
-            .is_some_and(|n| n.to_string_lossy().starts_with('.'));
-        let dicomdir = path
-            .file_name()
-            .is_some_and(|n| n.eq_ignore_ascii_case("DICOMDIR"));
-        if path.is_file() && !hidden && !dicomdir && has_preamble(&path)? {
-            files.push(path);
+    let mut pending = vec![(dir.to_path_buf(), 0)];
+    while let Some((folder, depth)) = pending.pop() {
+        let entries = std::fs::read_dir(&folder).map_err(|e| Error::io(&folder, e))?;
+        for entry in entries {
+            let entry = entry.map_err(|e| Error::io(&folder, e))?;
+            let path = entry.path();
+            let file_name = entry.file_name();
+            let hidden = file_name.to_string_lossy().starts_with('.');
+            let kind = entry.file_type().map_err(|e| Error::io(&path, e))?;
+            if hidden {
+                continue;
+            }
+            if kind.is_dir() && depth < MAX_DEPTH {
+                pending.push((path, depth + 1));
+            } else if path.is_file()
+                && !file_name.eq_ignore_ascii_case("DICOMDIR")
+                && has_preamble(&path)?
+            {
+                files.push(path);
+            }
         }
     }
     files.sort();
@@ -220,8 +351,14 @@ fn slice_header(path: PathBuf, obj: &DefaultDicomObject) -> Result<Slice> {
         .and_then(|e| e.to_str().ok())
         .map(|s| s.trim_end_matches(['\0', ' ']).to_string())
         .unwrap_or_default();
+    let description = obj
+        .get(tags::SERIES_DESCRIPTION)
+        .and_then(|e| e.to_str().ok())
+        .map(|s| s.trim_end_matches(['\0', ' ']).to_string())
+        .unwrap_or_default();
     Ok(Slice {
         series,
+        description,
         size: [int(tags::COLUMNS, "Columns")?, int(tags::ROWS, "Rows")?],
         dtype,
         orientation: [o[0], o[1], o[2], o[3], o[4], o[5]],
@@ -234,6 +371,78 @@ fn slice_header(path: PathBuf, obj: &DefaultDicomObject) -> Result<Slice> {
         depth: 0.0,
         path,
     })
+}
+
+/// Most gaps may differ from the median by this share before the series counts as uneven: real
+/// scanners jitter by about 2 %, a missing slice doubles a gap.
+const GAP_TOLERANCE: f64 = 0.2;
+
+/// The slice spacing of `slices` (sorted by depth) and whether they must be resampled onto it,
+/// or `None` for a single slice. Slices that are not evenly spaced (a missing slice, a gap
+/// between two stacks) are refused with their positions, unless `resample` asks for resampling
+/// onto the median spacing.
+fn even_spacing(dir: &Path, slices: &[Slice], resample: bool) -> Result<Option<(f64, bool)>> {
+    let gaps: Vec<f64> = slices.windows(2).map(|p| p[1].depth - p[0].depth).collect();
+    if gaps.is_empty() {
+        return Ok(None);
+    }
+    let mut sorted = gaps.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let uneven = gaps
+        .iter()
+        .position(|g| (g - median).abs() > GAP_TOLERANCE * median);
+    match uneven {
+        None => Ok(Some((gaps.iter().sum::<f64>() / gaps.len() as f64, false))),
+        Some(_) if resample => Ok(Some((median, true))),
+        Some(i) => Err(Error::file(
+            dir,
+            format!(
+                "the slices are not evenly spaced: {} is at {:.4} and {} at {:.4} along the slice \
+                 normal, {:.4} apart where the others are about {median:.4} (a missing slice?); \
+                 --resample-gaps resamples the series onto even spacing",
+                name(&slices[i].path),
+                slices[i].depth,
+                name(&slices[i + 1].path),
+                slices[i + 1].depth,
+                gaps[i]
+            ),
+        )),
+    }
+}
+
+/// `grid`'s slices, which sit at `depths`, linearly interpolated onto slices `dz` apart from
+/// the first. Values stay in stored units (the rescale map commutes with interpolation), as
+/// `f32` for 8- and 16-bit samples, `f64` otherwise.
+fn resample(grid: &Grid, depths: &[f64], dz: f64) -> Grid {
+    let [nx, ny, _] = grid.dims;
+    let nxy = nx * ny;
+    let span = depths[depths.len() - 1] - depths[0];
+    let nz = (span / dz).round() as usize + 1;
+    let values: Vec<f64> = with_samples!(&grid.samples, v => v.iter().map(|&x| sc_runtime::Scalar::to_f64(x)).collect());
+    let mut out = Vec::with_capacity(nxy * nz);
+    let mut below = 0;
+    for k in 0..nz {
+        let d = depths[0] + k as f64 * dz;
+        while below + 2 < depths.len() && depths[below + 1] <= d {
+            below += 1;
+        }
+        let (d0, d1) = (depths[below], depths[below + 1]);
+        let t = ((d - d0) / (d1 - d0)).clamp(0.0, 1.0);
+        let (a, b) = (
+            &values[below * nxy..][..nxy],
+            &values[(below + 1) * nxy..][..nxy],
+        );
+        out.extend(a.iter().zip(b).map(|(a, b)| a + t * (b - a)));
+    }
+    let samples = if grid.samples.dtype().size() <= 2 {
+        Samples::F32(out.iter().map(|&v| v as f32).collect())
+    } else {
+        Samples::F64(out)
+    };
+    let mut resampled = Grid::new(samples, [nx, ny, nz], grid.format);
+    resampled.scale = grid.scale;
+    resampled
 }
 
 fn check_one_series(slices: &[Slice]) -> Result<()> {

@@ -41,6 +41,8 @@ pub struct ReadOptions {
     pub raw: Option<RawLayout>,
     /// Array name inside an `.npz` archive.
     pub array: Option<String>,
+    /// Series choice and gap handling for a DICOM directory.
+    pub dicom: dicom::DicomOptions,
 }
 
 /// The input formats, told apart by extension (a directory is a DICOM series).
@@ -107,6 +109,11 @@ impl Format {
                 path.display()
             )));
         }
+        if options.dicom != dicom::DicomOptions::default() && format != Format::Dicom {
+            return Err(Error::Usage(
+                "--series and --resample-gaps apply to DICOM directories".into(),
+            ));
+        }
         if options.array.is_some() && format != Format::Npz {
             return Err(Error::Usage(
                 "--array selects an array in an .npz file".into(),
@@ -142,7 +149,7 @@ pub fn read(path: &Path, options: &ReadOptions, progress: &dyn Progress) -> Resu
         Format::Nrrd => nrrd::read(path, progress),
         Format::MetaImage => metaimage::read(path, progress),
         Format::Npy | Format::Npz => npy::read(path, options.array.as_deref(), progress),
-        Format::Dicom => dicom::read(path, progress),
+        Format::Dicom => dicom::read(path, &options.dicom, progress),
         Format::Sidecar => read_with_sidecar(path, progress),
     }?;
     grid.format = format.name();

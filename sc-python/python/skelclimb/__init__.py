@@ -218,7 +218,9 @@ def load(path, **options):
     """Reads a volume file with the ``skelclimb`` command's readers.
 
     NIfTI (``.nii``, ``.nii.gz``), NRRD (``.nrrd``, ``.nhdr``), MetaImage (``.mha``, ``.mhd``),
-    NumPy (``.npy``, ``.npz``; ``array=`` picks an array), a DICOM series (a directory), raw
+    NumPy (``.npy``, ``.npz``; ``array=`` picks an array), a DICOM series (a directory, searched
+    recursively; ``series=`` picks one by UID or number, ``resample_gaps=True`` resamples a
+    series with missing slices), raw
     samples with ``dims=(nx, ny, nz), dtype="i16"`` (and ``endian=``, ``header_bytes=``), or raw
     samples with a JSON sidecar.
 

