@@ -106,11 +106,11 @@ pub struct ExtractArgs {
     /// Use a built-in volume instead of a file; `knot` is the paper's knotted torus.
     #[arg(long, value_enum)]
     pub demo: Option<Demo>,
-    /// Samples per axis of the built-in volume.
-    #[arg(long, requires = "demo", default_value_t = 64)]
+    /// Samples per axis of the built-in volume (2 to 512: the volume is f64, 1 GiB at 512).
+    #[arg(long, requires = "demo", default_value_t = 64, value_parser = parse_size)]
     pub size: usize,
     /// The surface value: samples `>= iso` are inside. Required for files (see `skelclimb info`).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_iso)]
     pub iso: Option<f64>,
     /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format.
     #[arg(short, long, value_parser = parse_output)]
@@ -123,7 +123,7 @@ pub struct ExtractArgs {
     #[arg(long)]
     pub no_normals: bool,
     /// Worker threads; 0 uses every core. The mesh is the same for any number.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
     /// Surround the volume with one layer of empty samples, so that every surface is closed.
     #[arg(long)]
@@ -197,11 +197,11 @@ pub struct Table1Args {
     /// More volumes, each `FILE@ISO`, or just `FILE` to use its Otsu threshold.
     pub volumes: Vec<String>,
     /// Samples per axis of the built-in sphere, torus and noisy sphere (the knot is always 64,
-    /// as in the paper).
-    #[arg(long, default_value_t = 128)]
+    /// as in the paper; 2 to 512).
+    #[arg(long, default_value_t = 128, value_parser = parse_size)]
     pub size: usize,
     /// Worker threads; 0 uses every core.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
     /// How to read the volumes.
     #[command(flatten)]
@@ -267,8 +267,40 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
         })
         .collect::<Result<_, _>>()?;
     match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
-        _ => Err("expected three finite numbers X,Y,Z".into()),
+        [x, y, z] if v.iter().all(|c| c.is_finite() && c.abs() < 1e30) => Ok([*x, *y, *z]),
+        _ => Err("expected three finite numbers X,Y,Z (below 1e30: vertices are f32)".into()),
+    }
+}
+
+/// Threads beyond this are a mistake, not a machine: each costs a stack and a chunk of layers.
+const MAX_THREADS: usize = 1024;
+
+fn parse_threads(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a whole number"))?;
+    if n > MAX_THREADS {
+        return Err(format!("at most {MAX_THREADS} threads (0 uses every core)"));
+    }
+    Ok(n)
+}
+
+fn parse_size(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a whole number"))?;
+    if !(2..=512).contains(&n) {
+        return Err("the built-in volumes have 2 to 512 samples per axis".into());
+    }
+    Ok(n)
+}
+
+fn parse_iso(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err("the iso value must be a finite number".into())
     }
 }
 
@@ -326,6 +358,12 @@ mod tests {
         assert!(parse_dims("3,4").is_err());
         assert_eq!(parse_triple("-1.5,0,2e3"), Ok([-1.5, 0.0, 2000.0]));
         assert!(parse_spacing("1,0,1").is_err());
+        assert!(parse_triple("1,1e38,1").is_err());
+        assert!(parse_iso("nan").is_err() && parse_iso("inf").is_err());
+        assert_eq!(parse_iso("-2.5"), Ok(-2.5));
+        assert!(parse_threads("100000").is_err());
+        assert_eq!(parse_threads("8"), Ok(8));
+        assert!(parse_size("2000").is_err() && parse_size("1").is_err());
         assert!(parse_output("a.vtk").is_err());
         assert_eq!(parse_output("A.GLB").map(|o| o.format), Ok(MeshFormat::Glb));
         assert_eq!(

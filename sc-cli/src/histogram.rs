@@ -37,30 +37,39 @@ impl Histogram {
             mean: f64::NAN,
         };
         let scale = grid.scale;
-        let width = (hi - lo) / bins as f64;
-        let mut sum = 0.0;
+        // Halved, so that values near ±1.7e308 do not overflow `hi − lo` to infinity.
+        let width = (hi / 2.0 - lo / 2.0) / bins as f64;
+        let (mut mean, mut n) = (0.0, 0.0);
         with_samples!(&grid.samples, v => count(v, |x| {
             let x = scale.apply(x);
             if x.is_finite() {
-                sum += x;
-                let i = if width > 0.0 { ((x - lo) / width) as usize } else { 0 };
+                // A running mean cannot overflow where a sum would.
+                n += 1.0;
+                mean += x / n - mean / n;
+                let i = if width > 0.0 { ((x / 2.0 - lo / 2.0) / width) as usize } else { 0 };
                 h.counts[i.min(bins - 1)] += 1;
             }
         }));
         if range.finite > 0 {
-            h.mean = sum / range.finite as f64;
+            h.mean = mean;
         }
         h
     }
 
-    /// Width of one bin.
+    /// Width of one bin (infinite when the range spans more than `f64` holds).
     pub fn width(&self) -> f64 {
         (self.hi - self.lo) / self.counts.len() as f64
     }
 
-    /// Lower edge of bin `i`.
+    /// Lower edge of bin `i`, computed so that it stays finite for any finite range.
     pub fn edge(&self, i: usize) -> f64 {
-        self.lo + self.width() * i as f64
+        let half = (self.hi / 2.0 - self.lo / 2.0) / self.counts.len() as f64;
+        (self.lo / 2.0 + half * i as f64) * 2.0
+    }
+
+    /// Centre of bin `i`, finite for any finite range.
+    fn centre(&self, i: usize) -> f64 {
+        self.edge(i) / 2.0 + self.edge(i + 1) / 2.0
     }
 
     /// Otsu's threshold: the bin edge that best splits the values into two classes. Empty bins
@@ -68,7 +77,7 @@ impl Histogram {
     /// not its first edge, which would sit at the very top of the lower cluster.
     pub fn otsu(&self) -> Option<f64> {
         let total: u64 = self.counts.iter().sum();
-        let centre = |i: usize| self.edge(i) + self.width() / 2.0;
+        let centre = |i: usize| self.centre(i);
         let sum_all: f64 = self
             .counts
             .iter()
@@ -97,7 +106,7 @@ impl Histogram {
                 _ => {}
             }
         }
-        best.map(|(first, last)| (self.edge(first + 1) + self.edge(last + 1)) / 2.0)
+        best.map(|(first, last)| self.edge(first + 1) / 2.0 + self.edge(last + 1) / 2.0)
     }
 
     /// Up to `max` valleys `(centre, left peak, right peak)`, deepest first: bins of the smoothed
@@ -119,7 +128,7 @@ impl Histogram {
             })
             .collect();
         let least_peak = total as f64 * PEAK_SHARE / window as f64;
-        let centre = |i: usize| self.edge(i) + self.width() / 2.0;
+        let centre = |i: usize| self.centre(i);
         let peak = |range: &mut dyn Iterator<Item = usize>| {
             range
                 .map(|j| (smooth[j], j))
@@ -215,6 +224,19 @@ mod tests {
         let h = Histogram::of(&g, &g.range(), 64);
         let t = h.otsu().unwrap();
         assert!((t - 105.0).abs() <= h.width(), "{t}");
+    }
+
+    /// Values near the ends of `f64` give finite bins and mean, not NaN or infinity.
+    #[test]
+    fn extreme_values_stay_finite() {
+        let v = vec![-1.7e308, 1.7e308, 0.0, 1.0];
+        let g = Grid::new(Samples::F64(v), [4, 1, 1], "test");
+        let h = Histogram::of(&g, &g.range(), 16);
+        assert_eq!(h.counts.iter().sum::<u64>(), 4);
+        assert!(h.mean.is_finite());
+        assert!((0..=16).all(|i| h.edge(i).is_finite()));
+        assert_eq!(h.counts[0], 1);
+        assert_eq!(h.counts[15], 1);
     }
 
     #[test]

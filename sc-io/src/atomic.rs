@@ -73,7 +73,14 @@ impl AtomicFile {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let prefix = format!(".{name}.");
+        // The temporary name adds a dot, six random characters and `.tmp` to the target's: keep
+        // it short enough that a legal 255-byte target name still has a legal temporary name.
+        let cut = (0..=name.len().min(100))
+            .rev()
+            .find(|&i| name.is_char_boundary(i))
+            .unwrap_or(0);
+        let short = &name[..cut];
+        let prefix = format!(".{short}.");
         let mut builder = tempfile::Builder::new();
         builder.prefix(&prefix).suffix(".tmp");
         // A temporary file is private (0600) by default, and the rename would keep that: ask for
@@ -103,17 +110,37 @@ impl AtomicFile {
         self,
         fill: impl FnOnce(&mut BufWriter<&File>) -> io::Result<()>,
     ) -> Result<()> {
-        let target = self.target.clone();
-        let fail = |e: io::Error| Error::file(&target, format!("cannot write: {}", io_reason(&e)));
+        self.fill(fill)?.commit()
+    }
+
+    /// Writes the content to the temporary file and syncs it, without renaming yet: a run with
+    /// several outputs fills them all first and renames them only when every one is complete,
+    /// so a full disk leaves none of them half-updated.
+    pub fn fill(
+        self,
+        fill: impl FnOnce(&mut BufWriter<&File>) -> io::Result<()>,
+    ) -> Result<Filled> {
+        let fail =
+            |e: io::Error| Error::file(&self.target, format!("cannot write: {}", io_reason(&e)));
         let mut out = BufWriter::with_capacity(1 << 20, self.temp.as_file());
         fill(&mut out).map_err(fail)?;
         out.flush().map_err(fail)?;
         drop(out);
         self.temp.as_file().sync_all().map_err(fail)?;
-        self.temp
-            .persist(&self.target)
+        Ok(Filled(self))
+    }
+}
+
+/// A complete temporary file, waiting to be renamed over its target.
+pub struct Filled(AtomicFile);
+
+impl Filled {
+    /// Renames the file over its target.
+    pub fn commit(self) -> Result<()> {
+        let AtomicFile { temp, target, .. } = self.0;
+        temp.persist(&target)
             .map(drop)
-            .map_err(|e| fail(e.error))
+            .map_err(|e| Error::file(&target, format!("cannot write: {}", io_reason(&e.error))))
     }
 }
 

@@ -190,3 +190,25 @@ fn works_from_any_directory() {
             .is_file()
     );
 }
+
+/// `sc-tablegen dump | head`: the reader stops early, and the command ends without a panic.
+#[test]
+fn a_closed_pipe_ends_dump_quietly() {
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("sc-tablegen"))
+        .arg("dump")
+        .arg("--tables")
+        .arg(committed())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 16];
+    std::io::Read::read_exact(child.stdout.as_mut().unwrap(), &mut first).unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("Broken pipe"),
+        "{stderr}"
+    );
+}

@@ -1,6 +1,7 @@
 //! `skelclimb extract`.
 
 use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use sc_runtime::{Mesh, Mode};
@@ -41,6 +42,11 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     if args.ascii && args.output.format != MeshFormat::Ply {
         return Err(Error::Usage("--ascii applies to .ply output only".into()));
     }
+    check_outputs(
+        args.input.as_deref(),
+        &args.output.path,
+        args.stats_json.as_deref(),
+    )?;
     let mesh_file = AtomicFile::create(&args.output.path)?;
     let stats_file = args
         .stats_json
@@ -115,7 +121,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         "writing",
         approx_bytes(&mesh, args.output.format, args.ascii),
     );
-    mesh_file.write_with(|out| {
+    let mesh_filled = mesh_file.fill(|out| {
         let mut counted = Counted::new(out, &progress);
         let options = WriteOptions {
             ascii: args.ascii,
@@ -140,9 +146,17 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         paper_knot,
         edges: args.check.then(|| EdgeReport::of(&mesh.triangles)),
     };
-    if let Some(file) = stats_file {
-        let json = serde_json::to_vec_pretty(&summary.to_json()).map_err(std::io::Error::other);
-        file.write_with(|out| out.write_all(&json?))?;
+    // Both outputs are complete before either is renamed: all or nothing.
+    let stats_filled = match stats_file {
+        Some(file) => {
+            let json = serde_json::to_vec_pretty(&summary.to_json()).map_err(std::io::Error::other);
+            Some(file.fill(|out| out.write_all(&json?))?)
+        }
+        None => None,
+    };
+    mesh_filled.commit()?;
+    if let Some(filled) = stats_filled {
+        filled.commit()?;
     }
     if !quiet {
         println!("{summary}");
@@ -163,4 +177,44 @@ fn approx_bytes(mesh: &Mesh, format: MeshFormat, ascii: bool) -> u64 {
         MeshFormat::Obj => 3 * (12 * (v + n) + 12 * t),
     };
     if ascii { 3 * binary } else { binary }
+}
+
+/// Refuses a run whose outputs would overwrite its input or each other.
+fn check_outputs(input: Option<&Path>, mesh: &Path, stats: Option<&Path>) -> Result<()> {
+    let clash = |what: &str, a: &Path, b: &Path| -> Result<()> {
+        if same_place(a, b) {
+            return Err(Error::Usage(format!(
+                "{what} {} is the same file as {}; choose another name",
+                a.display(),
+                b.display()
+            )));
+        }
+        Ok(())
+    };
+    if let Some(input) = input {
+        clash("-o", mesh, input)?;
+    }
+    if let Some(stats) = stats {
+        clash("--stats-json", stats, mesh)?;
+        if let Some(input) = input {
+            clash("--stats-json", stats, input)?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether two paths name the same file, whether or not it exists yet: the folder is resolved
+/// (links, `..`) and the names compared.
+fn same_place(a: &Path, b: &Path) -> bool {
+    let resolve = |p: &Path| -> Option<PathBuf> {
+        if let Ok(full) = p.canonicalize() {
+            return Some(full);
+        }
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(dir.canonicalize().ok()?.join(p.file_name()?))
+    };
+    matches!((resolve(a), resolve(b)), (Some(x), Some(y)) if x == y)
 }

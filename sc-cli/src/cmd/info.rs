@@ -216,6 +216,9 @@ fn is_hounsfield(range: &Range) -> bool {
 
 /// A value for reading: at most four decimals, no trailing zeros, no negative zero.
 fn short(x: f64) -> String {
+    if x.is_finite() && x.abs() >= 1e15 {
+        return format!("{x:.4e}");
+    }
     let text = format!("{:.4}", x + 0.0);
     let text = if text.contains('.') {
         text.trim_end_matches('0').trim_end_matches('.')

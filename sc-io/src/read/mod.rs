@@ -153,7 +153,44 @@ pub fn read(path: &Path, options: &ReadOptions, progress: &dyn Progress) -> Resu
         Format::Sidecar => read_with_sidecar(path, progress),
     }?;
     grid.format = format.name();
+    check_placement(path, &grid)?;
     Ok(grid)
+}
+
+/// Refuses what would mesh into garbage: an empty volume, and spacing or origin that are not
+/// finite, not positive, or beyond what `f32` vertices can hold (NaN or infinite vertices make
+/// invalid glTF; zero spacing collapses the mesh to a plane).
+fn check_placement(path: &Path, grid: &Grid) -> Result<()> {
+    let [nx, ny, nz] = grid.dims;
+    if grid.dims.contains(&0) {
+        return Err(Error::file(
+            path,
+            format!("the volume has no samples: its dims are {nx} × {ny} × {nz}"),
+        ));
+    }
+    let usable = |v: f64| v.is_finite() && v.abs() < 1e30;
+    if !grid.spacing.iter().all(|&s| usable(s) && s > 0.0) {
+        return Err(Error::file(
+            path,
+            format!(
+                "the file's sample spacing {:?} is unusable: every spacing must be a positive \
+                 finite number (NIfTI pixdim or sform, NRRD spacings or space directions, \
+                 MetaImage ElementSpacing, DICOM PixelSpacing or slice positions)",
+                grid.spacing
+            ),
+        ));
+    }
+    if !grid.origin.iter().all(|&o| usable(o)) {
+        return Err(Error::file(
+            path,
+            format!(
+                "the file's origin {:?} is unusable: it must be finite (NIfTI sform or qform \
+                 offset, NRRD space origin, MetaImage Offset, DICOM ImagePositionPatient)",
+                grid.origin
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn read_with_sidecar(path: &Path, progress: &dyn Progress) -> Result<Grid> {
@@ -203,6 +240,9 @@ pub struct Block<'a> {
     pub layout: Layout,
 }
 
+/// Decoded bytes read after the samples of a compressed block to reach its checksum.
+const MAX_TRAILING: u64 = 1 << 20;
+
 /// Reads a sample block, with errors that name the data file and say what is missing.
 pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples> {
     let path = block.path;
@@ -246,7 +286,15 @@ pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples>
                 "the data ends before the samples start",
             ))
         } else {
-            payload::read_samples(decoded, block.layout, progress)
+            let verified = block.encoding == Encoding::Raw && block.skip_lines == 0;
+            let samples = payload::read_samples(&mut decoded, block.layout, verified, progress)?;
+            if block.encoding != Encoding::Raw {
+                // Reading on to the end of the stream is what makes the decoder check the
+                // gzip CRC and length (zlib: Adler-32): a flipped byte is an error, not a
+                // silently altered sample. What follows the samples is bounded, not trusted.
+                io::copy(&mut (&mut decoded).take(MAX_TRAILING), &mut io::sink())?;
+            }
+            Ok(samples)
         }
     });
     result.map_err(|e| match (block.encoding, e.kind()) {

@@ -66,10 +66,9 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
     };
     let mut grid = Grid::new(read_block(&block, progress)?, dims, "NIfTI-1");
 
-    grid.spacing = [1, 2, 3].map(|i| match f64::from(header.pixdim[i]).abs() {
-        s if s.is_finite() && s > 0.0 => s,
-        _ => 1.0,
-    });
+    // Spacing that is not a positive finite number is refused after reading (`check_placement`),
+    // naming pixdim, rather than replaced by a guess.
+    grid.spacing = [1, 2, 3].map(|i| f64::from(header.pixdim[i]).abs());
     let slope = f64::from(header.scl_slope);
     if slope != 0.0 && slope.is_finite() {
         grid.rescale(slope, f64::from(header.scl_inter));

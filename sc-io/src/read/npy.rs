@@ -109,6 +109,6 @@ fn read_array(
         count,
     };
     let samples =
-        payload::read_samples(reader, layout, progress).map_err(|e| Error::io(path, e))?;
+        payload::read_samples(reader, layout, false, progress).map_err(|e| Error::io(path, e))?;
     Ok(Grid::new(samples, dims, "NumPy"))
 }

@@ -149,7 +149,7 @@ fn place(h: &TextHeader, grid: &mut Grid) -> Result<()> {
         _ => {
             if let Some(s) = h.get("spacings") {
                 let s = h.numbers::<f64>("spacings", s, 3)?;
-                grid.spacing = [s[0], s[1], s[2]].map(|x| if x.is_finite() { x } else { 1.0 });
+                grid.spacing = [s[0], s[1], s[2]];
             }
             grid.frame = space.map(Frame::aligned);
         }

@@ -52,12 +52,18 @@ pub fn decode<'a>(reader: impl Read + 'a, encoding: Encoding) -> Box<dyn Read + 
 ///
 /// A short read says how far the data got, which is what a user needs to tell a truncated
 /// download from wrong dimensions.
+///
+/// `verified` says the payload was checked to hold `layout`'s bytes (an uncompressed file of the
+/// right length): then the samples are allocated at once. Otherwise (compressed data, archive
+/// members) they grow as bytes actually arrive, so a header that claims a huge volume over a
+/// small payload fails at the end of the data instead of aborting on an allocation.
 pub fn read_samples(
     reader: impl Read,
     layout: Layout,
+    verified: bool,
     progress: &dyn Progress,
 ) -> io::Result<Samples> {
-    with_dtype!(layout.dtype, T => read_typed::<T>(reader, layout, progress).map(Sample::wrap))
+    with_dtype!(layout.dtype, T => read_typed::<T>(reader, layout, verified, progress).map(Sample::wrap))
 }
 
 /// Chunk size for progress updates: large enough that the bar costs nothing.
@@ -66,6 +72,7 @@ const CHUNK: usize = 1 << 22;
 fn read_typed<T: Sample>(
     mut reader: impl Read,
     layout: Layout,
+    verified: bool,
     progress: &dyn Progress,
 ) -> io::Result<Vec<T>> {
     let need = layout.bytes().ok_or_else(|| {
@@ -75,11 +82,30 @@ fn read_typed<T: Sample>(
         )
     })?;
     progress.phase("reading", need as u64);
-    let mut samples = vec![T::zeroed(); layout.count];
-    let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut samples);
+    let size = layout.dtype.size();
+    let mut samples: Vec<T> = Vec::new();
+    let no_memory = || {
+        io::Error::new(
+            io::ErrorKind::OutOfMemory,
+            format!("not enough memory for {need} bytes of samples"),
+        )
+    };
+    if verified {
+        samples
+            .try_reserve_exact(layout.count)
+            .map_err(|_| no_memory())?;
+    }
     let mut got = 0;
     while got < need {
         let end = need.min(got + CHUNK);
+        let want = end.div_ceil(size);
+        if samples.len() < want {
+            samples
+                .try_reserve(want - samples.len())
+                .map_err(|_| no_memory())?;
+            samples.resize(want, T::zeroed());
+        }
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut samples);
         match reader.read(&mut bytes[got..end]) {
             Ok(0) => {
                 return Err(io::Error::new(
@@ -98,8 +124,8 @@ fn read_typed<T: Sample>(
             Err(e) => return Err(e),
         }
     }
-    if layout.endian != Endian::native() && layout.dtype.size() > 1 {
-        bytes
+    if layout.endian != Endian::native() && size > 1 {
+        bytemuck::cast_slice_mut::<T, u8>(&mut samples)
             .chunks_exact_mut(layout.dtype.size())
             .for_each(<[u8]>::reverse);
     }
@@ -127,7 +153,12 @@ mod tests {
             endian,
             count,
         };
-        read_samples(decode(bytes, encoding), layout, &crate::progress::Silent)
+        read_samples(
+            decode(bytes, encoding),
+            layout,
+            false,
+            &crate::progress::Silent,
+        )
     }
 
     #[test]

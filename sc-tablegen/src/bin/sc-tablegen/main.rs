@@ -85,6 +85,13 @@ enum Format {
 }
 
 fn main() -> ExitCode {
+    // `sc-tablegen dump | head`: end quietly when the reader stops, as Unix tools do, rather
+    // than panic in `println!` (Rust ignores SIGPIPE by default).
+    #[cfg(unix)]
+    // SAFETY: SIG_DFL at start-up, before any thread exists, installs no handler code.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     match run(Cli::parse().command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(msg) => {
