@@ -262,3 +262,87 @@ fn a_closed_pipe_ends_the_command_quietly() {
         "{stderr}"
     );
 }
+
+#[test]
+fn headers_cannot_point_anywhere_or_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("v.raw"), [0u8; 64]).unwrap();
+    let nrrd = |extra: &str| {
+        format!("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n{extra}")
+    };
+    for (extra, message) in [
+        ("data file: /dev/zero\n", "outside the header's folder"),
+        ("data file: ../v.raw\n", "outside the header's folder"),
+        ("data file: \n", "data file name is empty"),
+        (
+            "line skip: 18446744073709551615\ndata file: v.raw\n",
+            "lines the header says",
+        ),
+        (
+            "line skip: 1000000000\ndata file: v.raw\n",
+            "lines the header says",
+        ),
+    ] {
+        std::fs::write(d.join("v.nhdr"), nrrd(extra)).unwrap();
+        refused(
+            d,
+            &["extract", "v.nhdr", "--iso", "1", "-o", "m.ply"],
+            1,
+            message,
+        );
+    }
+    std::fs::remove_file(d.join("v.nhdr")).unwrap();
+    std::fs::write(
+        d.join("v.mhd"),
+        "ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\n\
+         HeaderSize = 18446744073709551615\nElementDataFile = LOCAL\n",
+    )
+    .unwrap();
+    refused(
+        d,
+        &["extract", "v.mhd", "--iso", "1", "-o", "m.ply"],
+        1,
+        "HeaderSize",
+    );
+}
+
+#[test]
+fn numpy_headers_are_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut v2 = b"\x93NUMPY\x02\x00".to_vec();
+    v2.extend(u32::MAX.to_le_bytes());
+    v2.extend(b"{'descr': '<f4'}");
+    std::fs::write(d.join("long.npy"), v2).unwrap();
+    refused(d, &["info", "long.npy"], 1, "implausible");
+    let descr = format!(
+        "{{'descr': {}'<f4'{}, 'fortran_order': False, 'shape': (2, 2, 2), }}",
+        "[(".repeat(40),
+        ")]".repeat(40)
+    );
+    let mut nested = b"\x93NUMPY\x01\x00".to_vec();
+    nested.extend((descr.len() as u16).to_le_bytes());
+    nested.extend(descr.as_bytes());
+    std::fs::write(d.join("nested.npy"), nested).unwrap();
+    refused(d, &["info", "nested.npy"], 1, "nest");
+}
+
+#[test]
+fn a_truncated_nifti_header_is_described_in_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("cut.nii.gz"), gzip(&nifti()[..200])).unwrap();
+    let out = Command::cargo_bin("skelclimb")
+        .unwrap()
+        .current_dir(d)
+        .args(["info", "cut.nii.gz"])
+        .assert()
+        .code(1)
+        .stderr(contains("cut.nii.gz"));
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    assert!(
+        !stderr.contains("Custom {") && !stderr.contains("kind:"),
+        "{stderr}"
+    );
+}

@@ -124,9 +124,30 @@ impl TextHeader {
         }
     }
 
-    /// The path of a detached data file named in the header, relative to the header's directory.
-    pub fn sibling(&self, name: &str) -> PathBuf {
-        self.path.parent().unwrap_or(Path::new(".")).join(name)
+    /// The path of a detached data file named in the header, relative to the header's folder.
+    /// It must stay in that folder or below (no absolute path, no `..`), and be a regular file:
+    /// a header can then not make the reader open `/dev/zero` or another user's files.
+    pub fn sibling(&self, name: &str) -> Result<PathBuf> {
+        if name.is_empty() {
+            return Err(self.error("the data file name is empty"));
+        }
+        let relative = Path::new(name);
+        let escapes = relative.components().any(|c| {
+            !matches!(
+                c,
+                std::path::Component::Normal(_) | std::path::Component::CurDir
+            )
+        });
+        if escapes {
+            return Err(self.error(format!(
+                "data file {name:?} points outside the header's folder"
+            )));
+        }
+        let path = self.path.parent().unwrap_or(Path::new(".")).join(relative);
+        if path.exists() && !path.is_file() {
+            return Err(self.error(format!("data file {name:?} is not a regular file")));
+        }
+        Ok(path)
     }
 }
 

@@ -55,14 +55,18 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
         );
     }
     let local = data_file.eq_ignore_ascii_case("LOCAL");
-    let data_path = (!local).then(|| h.sibling(data_file));
+    let data_path = (!local).then(|| h.sibling(data_file)).transpose()?;
     let start = match h.get("HeaderSize") {
         Some("-1") if !compressed => Start::End,
         Some(n) => {
             let skip: u64 = n
                 .parse()
                 .map_err(|_| h.error(format!("bad HeaderSize {n:?}")))?;
-            Start::At(if local { h.data_offset } else { 0 } + skip)
+            let base = if local { h.data_offset } else { 0 };
+            Start::At(
+                base.checked_add(skip)
+                    .ok_or_else(|| h.error(format!("HeaderSize {n} is past any file")))?,
+            )
         }
         None => Start::At(if local { h.data_offset } else { 0 }),
     };

@@ -271,8 +271,16 @@ pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples>
     file.seek(SeekFrom::Start(start))
         .map_err(|e| Error::io(path, e))?;
     let mut reader = BufReader::with_capacity(1 << 20, file);
-    for _ in 0..block.skip_lines {
-        reader.skip_until(b'\n').map_err(|e| Error::io(path, e))?;
+    for skipped in 0..block.skip_lines {
+        if reader.skip_until(b'\n').map_err(|e| Error::io(path, e))? == 0 {
+            return Err(Error::file(
+                path,
+                format!(
+                    "the file ends after {skipped} of the {} lines the header says to skip",
+                    block.skip_lines
+                ),
+            ));
+        }
     }
     let mut decoded = payload::decode(reader, block.encoding);
     let skipped = io::copy(

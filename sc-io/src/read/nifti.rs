@@ -23,7 +23,15 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
     let encoding = if gz { Encoding::Gzip } else { Encoding::Raw };
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
     let header = NiftiHeader::from_reader(super::payload::decode(BufReader::new(file), encoding))
-        .map_err(|e| Error::file(path, format!("not a readable NIfTI-1 header: {e}")))?;
+        .map_err(|e| match e {
+        // The crate's own text for I/O errors is debug output; say it in words.
+        nifti::NiftiError::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => Error::file(
+            path,
+            "not a readable NIfTI-1 header: the file ends inside it",
+        ),
+        nifti::NiftiError::Io(io) => Error::io(path, io),
+        other => Error::file(path, format!("not a readable NIfTI-1 header: {other}")),
+    })?;
     let bad = |message: String| Error::file(path, format!("NIfTI header: {message}"));
     // The crate takes a wrong sizeof_hdr as a byte-order hint, not as corruption.
     if header.sizeof_hdr != 348 {

@@ -7,7 +7,7 @@
 //! moved; only the shape is read in the right direction.
 
 use std::fs::File;
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use npyz::npz::NpzArchive;
@@ -26,6 +26,9 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     if !is_npz {
         let mut file = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+        check_header(path, &mut file)?;
+        file.seek(SeekFrom::Start(0))
+            .map_err(|e| Error::io(path, e))?;
         let header = NpyHeader::from_reader(&mut file)
             .map_err(|e| Error::file(path, format!("not a readable .npy header: {e}")))?;
         return read_array(path, &header, file, progress);
@@ -41,7 +44,7 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
                 path,
                 format!(
                     "the archive holds arrays {}: choose one with --array",
-                    names.join(", ")
+                    listing(&names)
                 ),
             ));
         }
@@ -52,11 +55,75 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
             path,
             format!(
                 "no array named {name:?}; the archive holds {}",
-                names.join(", ")
+                listing(&names)
             ),
         )),
         Err(e) => Err(Error::file(path, format!("array {name:?}: {e}"))),
     }
+}
+
+/// Array names for a message: the first ten, and how many more.
+fn listing(names: &[String]) -> String {
+    let shown = names
+        .iter()
+        .take(10)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    match names.len() {
+        n if n > 10 => format!("{shown} and {} more", n - 10),
+        _ => shown,
+    }
+}
+
+/// The longest `.npy` header we read: real ones are a few hundred bytes.
+const MAX_HEADER: usize = 1 << 16;
+
+/// Deepest bracket nesting accepted in a header: npyz's parser takes time exponential in it,
+/// and no real dtype nests more than a few levels.
+const MAX_NESTING: usize = 16;
+
+/// Checks the header's declared length and nesting before the parser sees it, so that a hostile
+/// header can make it neither allocate gigabytes nor run for minutes.
+fn check_header(path: &Path, file: &mut impl Read) -> Result<()> {
+    let bad = |m: String| Error::file(path, format!("not a readable .npy header: {m}"));
+    let mut start = [0u8; 12];
+    file.read_exact(&mut start[..10])
+        .map_err(|_| bad("the file is shorter than a header".into()))?;
+    if &start[..6] != b"\x93NUMPY" {
+        return Err(bad("the file does not start with the .npy magic".into()));
+    }
+    let len = match start[6] {
+        1 => usize::from(u16::from_le_bytes([start[8], start[9]])),
+        2 | 3 => {
+            file.read_exact(&mut start[10..12])
+                .map_err(|_| bad("the file is shorter than a header".into()))?;
+            u32::from_le_bytes([start[8], start[9], start[10], start[11]]) as usize
+        }
+        v => return Err(bad(format!("format version {v} is unknown"))),
+    };
+    if len > MAX_HEADER {
+        return Err(bad(format!(
+            "a header length of {len} bytes is implausible"
+        )));
+    }
+    let mut text = vec![0u8; len];
+    file.read_exact(&mut text)
+        .map_err(|_| bad(format!("the file ends inside its {len}-byte header")))?;
+    let mut depth = 0usize;
+    for &c in &text {
+        match c {
+            b'[' | b'(' | b'{' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(bad(format!("brackets nest more than {MAX_NESTING} deep")));
+                }
+            }
+            b']' | b')' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn read_array(

@@ -65,7 +65,7 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
     if detached.is_some_and(|d| d.starts_with("LIST") || d.contains(' ')) {
         return Err(h.error("multi-file data (\"data file: LIST\" or a pattern) is not supported"));
     }
-    let data_path = detached.map(|name| h.sibling(name));
+    let data_path = detached.map(|name| h.sibling(name)).transpose()?;
     let attached_at = if detached.is_some() { 0 } else { h.data_offset };
     // The NRRD spec applies the byte skip to the file for raw data and to the decoded stream for
     // compressed data; -1 (raw only) means "the samples are the last bytes".
