@@ -142,3 +142,26 @@ fn slices_in_nested_folders_are_found() {
     let whole = triangles(&series(), &[], &tmp.path().join("w.ply"));
     assert_eq!(triangles(tmp.path(), &[], &tmp.path().join("n.ply")), whole);
 }
+
+#[test]
+fn a_slice_claiming_huge_rows_and_columns_is_refused_before_decoding() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("huge");
+    std::fs::create_dir(&dir).unwrap();
+    let mut obj = dicom_object::open_file(&slices()[1]).unwrap();
+    for tag in [tags::ROWS, tags::COLUMNS] {
+        obj.put(DataElement::new(
+            tag,
+            VR::US,
+            PrimitiveValue::from(65535u16),
+        ));
+    }
+    obj.write_to_file(dir.join("huge.dcm")).unwrap();
+    skelclimb()
+        .arg("info")
+        .arg(&dir)
+        .assert()
+        .code(1)
+        .stderr(contains("huge.dcm"))
+        .stderr(contains("Rows 65535 × Columns 65535"));
+}

@@ -356,10 +356,27 @@ fn slice_header(path: PathBuf, obj: &DefaultDicomObject) -> Result<Slice> {
         .and_then(|e| e.to_str().ok())
         .map(|s| s.trim_end_matches(['\0', ' ']).to_string())
         .unwrap_or_default();
+    let size = [int(tags::COLUMNS, "Columns")?, int(tags::ROWS, "Rows")?];
+    // Decoders allocate Rows × Columns samples before they look at the data: refuse sizes the
+    // file cannot hold even at a generous compression ratio.
+    let file_len = std::fs::metadata(&path)
+        .map_err(|e| Error::io(&path, e))?
+        .len();
+    let pixel_bytes = u64::from(size[0]) * u64::from(size[1]) * u64::from(bits / 8);
+    if pixel_bytes > (64 * file_len).max(1 << 24) {
+        return Err(Error::file(
+            &path,
+            format!(
+                "Rows {} × Columns {} of {bits}-bit samples ({pixel_bytes} bytes) cannot come from \
+                 a {file_len}-byte file",
+                size[1], size[0]
+            ),
+        ));
+    }
     Ok(Slice {
         series,
         description,
-        size: [int(tags::COLUMNS, "Columns")?, int(tags::ROWS, "Rows")?],
+        size,
         dtype,
         orientation: [o[0], o[1], o[2], o[3], o[4], o[5]],
         position: [p[0], p[1], p[2]],
@@ -510,18 +527,25 @@ where
                     format!("cannot read the pixel data: {}", with_causes(&e)),
                 )
             })?;
-        let pixels = obj.decode_pixel_data().map_err(|e| {
-            Error::file(
-                path,
-                format!("cannot decode the pixel data: {}", with_causes(&e)),
-            )
-        })?;
-        let values: Vec<T> = pixels.to_vec_frame_with_options(0, options).map_err(|e| {
-            Error::file(
-                path,
-                format!("cannot convert the pixel data: {}", with_causes(&e)),
-            )
-        })?;
+        // The pixel decoders (RLE, JPEG) panic on some corrupt fragments: a bad slice must
+        // become an error naming it, not end the program.
+        let decoded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let pixels = obj
+                .decode_pixel_data()
+                .map_err(|e| format!("cannot decode the pixel data: {}", with_causes(&e)))?;
+            pixels
+                .to_vec_frame_with_options::<T>(0, options)
+                .map_err(|e| format!("cannot convert the pixel data: {}", with_causes(&e)))
+        }));
+        let values: Vec<T> = match decoded {
+            Ok(result) => result.map_err(|message| Error::file(path, message))?,
+            Err(_) => {
+                return Err(Error::file(
+                    path,
+                    "the pixel data is corrupt (its decoder failed)",
+                ));
+            }
+        };
         if values.len() != per_slice {
             return Err(Error::file(
                 path,
