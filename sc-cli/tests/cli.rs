@@ -1,30 +1,17 @@
 //! The real `skelclimb` binary on the fixtures: outputs, exit codes, messages, and that no
 //! failure leaves a file behind.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::{entries, fixture, nifti};
+
+use std::path::Path;
 
 use assert_cmd::Command;
 use predicates::prelude::*;
 use predicates::str::contains;
 
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/data")
-        .join(name)
-}
-
 fn skelclimb() -> Command {
     Command::cargo_bin("skelclimb").unwrap()
-}
-
-/// Names in `dir`, to check that failures leave nothing (not even a temporary file).
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// Runs `args` expecting exit `code`, a message containing `message`, and no new file in `dir`.
@@ -340,18 +327,10 @@ fn truncated_and_corrupt_gzip() {
     );
 }
 
-/// Decompressed NIfTI bytes of the fixture, to patch header fields into.
-fn nifti_bytes() -> Vec<u8> {
-    let gz = std::fs::read(fixture("itk-t1-mri.nii.gz")).unwrap();
-    let mut nii = Vec::new();
-    std::io::copy(&mut flate2::read::GzDecoder::new(&gz[..]), &mut nii).unwrap();
-    nii
-}
-
 #[test]
 fn unsupported_nifti_datatype_and_corrupt_header() {
     let dir = tempfile::tempdir().unwrap();
-    let mut complex = nifti_bytes();
+    let mut complex = nifti();
     complex[70..72].copy_from_slice(&32i16.to_le_bytes()); // datatype: complex64
     complex[72..74].copy_from_slice(&64i16.to_le_bytes()); // bitpix
     std::fs::write(dir.path().join("complex.nii"), complex).unwrap();
@@ -362,7 +341,7 @@ fn unsupported_nifti_datatype_and_corrupt_header() {
         "complex.nii: NIfTI header: datatype",
     );
 
-    let mut corrupt = nifti_bytes();
+    let mut corrupt = nifti();
     corrupt[..4].copy_from_slice(b"junk");
     std::fs::write(dir.path().join("corrupt.nii"), corrupt).unwrap();
     fails(

@@ -1,6 +1,8 @@
 //! DICOM directories as exports deliver them: a missing slice, several series in one folder,
 //! slices in nested folders.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;

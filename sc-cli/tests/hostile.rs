@@ -1,27 +1,14 @@
 //! Hostile and careless input: each case is a clear error naming the file or option, with exit
 //! 1 (data) or 2 (usage), no panic, no allocation abort and no file left behind.
 
-use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+mod common;
+use common::{entries, fixture, gzip, nifti};
+
+use std::path::Path;
 use std::process::Stdio;
 
 use assert_cmd::Command;
 use predicates::str::contains;
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/data")
-        .join(name)
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
 
 /// Runs `args` in `dir`, expecting exit `code`, `message` on stderr, no panic and no new file.
 fn refused(dir: &Path, args: &[&str], code: i32, message: &str) {
@@ -36,21 +23,6 @@ fn refused(dir: &Path, args: &[&str], code: i32, message: &str) {
     let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(entries(dir), before, "{args:?} left files behind");
-}
-
-fn nifti() -> Vec<u8> {
-    let gz = std::fs::read(fixture("itk-t1-mri.nii.gz")).unwrap();
-    let mut nii = Vec::new();
-    flate2::read::GzDecoder::new(&gz[..])
-        .read_to_end(&mut nii)
-        .unwrap();
-    nii
-}
-
-fn gzip(bytes: &[u8]) -> Vec<u8> {
-    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    e.write_all(bytes).unwrap();
-    e.finish().unwrap()
 }
 
 #[test]

@@ -1,16 +1,13 @@
 //! Raw volumes with a JSON sidecar: `skelclimb` reads the layout and placement from it, the same
 //! mesh as spelling them out with `--dims`, `--dtype` and `--spacing`.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::fixture;
+
+use std::path::Path;
 
 use assert_cmd::Command;
 use predicates::str::contains;
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/data")
-        .join(name)
-}
 
 fn extract(input: &Path, extra: &[&str], out: &Path) {
     Command::cargo_bin("skelclimb")

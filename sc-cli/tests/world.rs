@@ -3,19 +3,15 @@
 //! interpolation; padded surfaces enclose positive volume (faces point out) whatever the map's
 //! handedness.
 
-use std::io::Read;
-use std::path::{Path, PathBuf};
+mod common;
+use common::{fixture, nifti};
+
+use std::path::Path;
 
 use assert_cmd::Command;
 use sc_io::progress::Silent;
 use sc_io::read::{ReadOptions, read};
 use sc_io::volume::{Grid, Samples};
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/data")
-        .join(name)
-}
 
 struct Obj {
     positions: Vec<[f64; 3]>,
@@ -164,15 +160,6 @@ fn normals_agreement(mesh: &Obj) -> f64 {
     agree as f64 / mesh.triangles.len() as f64
 }
 
-fn nifti_bytes() -> Vec<u8> {
-    let gz = std::fs::read(fixture("itk-t1-mri.nii.gz")).unwrap();
-    let mut nii = Vec::new();
-    flate2::read::GzDecoder::new(&gz[..])
-        .read_to_end(&mut nii)
-        .unwrap();
-    nii
-}
-
 fn set_i16(bytes: &mut [u8], at: usize, v: i16) {
     bytes[at..at + 2].copy_from_slice(&v.to_le_bytes());
 }
@@ -209,7 +196,7 @@ fn nifti_sform_lands_inside_the_image_where_nibabel_puts_it() {
 #[test]
 fn nifti_qform_and_a_mirrored_qform_keep_faces_outward() {
     let dir = tempfile::tempdir().unwrap();
-    let mut nii = nifti_bytes();
+    let mut nii = nifti();
     set_i16(&mut nii, 254, 0); // sform_code: the qform places the volume
     let qform = dir.path().join("qform.nii");
     std::fs::write(&qform, &nii).unwrap();
