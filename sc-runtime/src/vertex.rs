@@ -37,18 +37,37 @@ impl<T: Scalar> Field<'_, T> {
         self.slice(p[2])[p[0] + self.dims[0] * p[1]].to_f64()
     }
 
-    /// Central differences inside, one-sided at the border, divided by spacing.
+    /// Central differences inside, one-sided at the border, divided by spacing. Each axis
+    /// reads its two samples straight from their slices: the normals pass calls this twice per
+    /// vertex, and a general "sample at point" lookup cost as much as the rest of the sweep.
     pub fn gradient(&self, p: [usize; 3]) -> [f64; 3] {
-        core::array::from_fn(|d| {
-            let n = self.dims[d];
-            let at = |c: usize| {
-                let mut q = p;
-                q[d] = c;
-                self.value(q)
-            };
-            let (lo, hi) = (p[d].saturating_sub(1), (p[d] + 1).min(n - 1));
-            (at(hi) - at(lo)) / ((hi - lo) as f64 * self.spacing[d])
-        })
+        let [x, y, z] = p;
+        let [nx, ny, nz] = self.dims;
+        let step = |c: usize, n: usize| (c.saturating_sub(1), (c + 1).min(n - 1));
+        let diff = |a: f64, b: f64, lo: usize, hi: usize, d: usize| {
+            (b - a) / ((hi - lo) as f64 * self.spacing[d])
+        };
+        let here = self.slice(z);
+        let row = nx * y;
+        let (xl, xh) = step(x, nx);
+        let gx = diff(here[row + xl].to_f64(), here[row + xh].to_f64(), xl, xh, 0);
+        let (yl, yh) = step(y, ny);
+        let gy = diff(
+            here[nx * yl + x].to_f64(),
+            here[nx * yh + x].to_f64(),
+            yl,
+            yh,
+            1,
+        );
+        let (zl, zh) = step(z, nz);
+        let gz = diff(
+            self.slice(zl)[row + x].to_f64(),
+            self.slice(zh)[row + x].to_f64(),
+            zl,
+            zh,
+            2,
+        );
+        [gx, gy, gz]
     }
 
     /// The outward unit normal at `t` along the edge from `p` along `axis`: the negated,
