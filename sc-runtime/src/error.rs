@@ -31,6 +31,38 @@ pub enum Error {
         /// The slice's length.
         actual: usize,
     },
+    /// A block's cube range leaves the grid (cubes run from 0 to one less than the samples).
+    BlockOutsideGrid {
+        /// 0, 1, 2 for x, y, z.
+        axis: usize,
+        /// The cubes asked for along that axis.
+        cubes: core::ops::Range<usize>,
+        /// Samples of the grid along that axis.
+        grid: usize,
+    },
+    /// A block's samples do not cover the halo its decisions read (`block_samples`).
+    HaloTooSmall {
+        /// 0, 1, 2 for x, y, z.
+        axis: usize,
+        /// The samples given along that axis.
+        have: core::ops::Range<usize>,
+        /// The samples needed along that axis.
+        need: core::ops::Range<usize>,
+    },
+    /// Block meshes of different grids or settings (normals, positions of a shared vertex).
+    BlocksDiffer,
+    /// Two block meshes own the same cube.
+    BlocksOverlap {
+        /// The cube's key.
+        cube: u64,
+    },
+    /// The joined blocks do not cover the grid.
+    BlocksMissing {
+        /// Cubes the blocks own.
+        covered: u64,
+        /// Cubes of the grid.
+        cubes: u64,
+    },
 }
 
 impl fmt::Display for Error {
@@ -57,8 +89,33 @@ impl fmt::Display for Error {
             Error::SliceLength { expected, actual } => {
                 write!(f, "expected a slice of {expected} samples, got {actual}")
             }
+            Error::BlockOutsideGrid { axis, cubes, grid } => write!(
+                f,
+                "cubes {}..{} along {} leave a grid of {grid} samples (cubes 0..{})",
+                cubes.start,
+                cubes.end,
+                AXES[*axis],
+                grid.saturating_sub(1)
+            ),
+            Error::HaloTooSmall { axis, have, need } => write!(
+                f,
+                "the block's samples {}..{} along {} do not cover the {}..{} its cubes read",
+                have.start, have.end, AXES[*axis], need.start, need.end
+            ),
+            Error::BlocksDiffer => f.write_str(
+                "the block meshes come from different grids or settings and cannot be joined",
+            ),
+            Error::BlocksOverlap { cube } => {
+                write!(f, "two block meshes both own cube {cube}")
+            }
+            Error::BlocksMissing { covered, cubes } => write!(
+                f,
+                "the joined blocks cover {covered} of the grid's {cubes} cubes"
+            ),
         }
     }
 }
+
+const AXES: [&str; 3] = ["x", "y", "z"];
 
 impl core::error::Error for Error {}

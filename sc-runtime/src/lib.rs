@@ -30,6 +30,10 @@ pub use stats::Stats;
 mod mesh;
 #[cfg(feature = "alloc")]
 pub use mesh::{Mesh, extract};
+#[cfg(feature = "alloc")]
+mod block;
+#[cfg(feature = "alloc")]
+pub use block::{BlockMesh, block_samples, edge_key, extract_block};
 
 mod extract;
 mod stream;

@@ -128,14 +128,6 @@ fn stitch(parts: Vec<Part>) -> Result<Mesh, Error> {
             *d = s.map(|i| i + shift);
         }
     });
-    for part in &parts {
-        let s = part.mesh.stats;
-        out.stats.v13 += s.v13;
-        out.stats.t13 += s.t13;
-        out.stats.merged += s.merged;
-        out.stats.blocked += s.blocked;
-        out.stats.vertices += s.vertices;
-        out.stats.triangles += s.triangles;
-    }
+    out.stats = parts.iter().fold(Stats::default(), |s, p| s + p.mesh.stats);
     Ok(out)
 }

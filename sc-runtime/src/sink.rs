@@ -6,6 +6,27 @@ pub trait Sink {
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>);
     /// A triangle, wound so that `(b − a) × (c − a)` points from filled to empty.
     fn triangle(&mut self, triangle: [u32; 3]);
+    /// [`Sink::vertex`], told which grid edge the vertex lies on: its lower end and axis, in the
+    /// whole grid's indices. Vertices are named by their edges when blocks meshed apart are
+    /// joined (see `extract_block`); the default forgets the name.
+    #[inline]
+    fn edge_vertex(
+        &mut self,
+        lower: [usize; 3],
+        axis: usize,
+        position: [f32; 3],
+        normal: Option<[f32; 3]>,
+    ) {
+        let _ = (lower, axis);
+        self.vertex(position, normal);
+    }
+    /// [`Sink::triangle`], told which cube emits it (its lower corner, in the whole grid's
+    /// indices); a merged pair's triangle belongs to the lower cube of the pair.
+    #[inline]
+    fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {
+        let _ = cube;
+        self.triangle(triangle);
+    }
     /// A hint, after each layer: about this many more vertices and triangles are to come
     /// (extrapolated from the layers so far). A sink that allocates can reserve once instead of
     /// growing by doubling; the default ignores it.

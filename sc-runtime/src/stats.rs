@@ -14,3 +14,19 @@ pub struct Stats {
     /// Triangles in the output.
     pub triangles: u64,
 }
+
+/// Counts of disjoint parts (parallel chunks, blocks) add up to the counts of the whole.
+impl core::ops::Add for Stats {
+    type Output = Stats;
+
+    fn add(self, b: Stats) -> Stats {
+        Stats {
+            v13: self.v13 + b.v13,
+            t13: self.t13 + b.t13,
+            merged: self.merged + b.merged,
+            blocked: self.blocked + b.blocked,
+            vertices: self.vertices + b.vertices,
+            triangles: self.triangles + b.triangles,
+        }
+    }
+}

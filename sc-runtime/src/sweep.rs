@@ -50,6 +50,13 @@ struct Grid<'s> {
     /// `(lo, hi)` pairs: per classified row, the x-edge changes lie in `lo..hi` (`lo = nx − 1`,
     /// `hi = 0` for a uniform row); per cube row, the non-trivial cubes lie in `lo..hi`.
     spans: &'s mut [u32],
+    /// Where these samples sit in the whole grid: a block's vertices and triangles are reported
+    /// in global indices, and the parity classes follow global indices.
+    offset: [usize; 3],
+    /// Per axis, the cubes whose triangles this sweep emits and the edge lower ends it counts
+    /// (local indices); everything, except for a block, whose halo is only read.
+    own_cubes: [(usize, usize); 3],
+    own_edges: [(usize, usize); 3],
 }
 
 /// Vertex numbering and counts.
@@ -85,6 +92,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 filled,
                 cases: &mut rest[..3 * nxy],
                 spans,
+                offset: [0; 3],
+                own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
+                own_edges: dims.map(|n| (0, n)),
             },
             out: Out {
                 ids,
@@ -96,6 +106,26 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             threshold: T::threshold(params.iso),
             first_layer: 0,
         }
+    }
+
+    /// Makes this a block's sweep: its samples start at `offset` in the whole grid, and it emits
+    /// the triangles of the local cubes `own` only, counting the edges whose lower ends those
+    /// cubes hold (and, on the grid's far side, the last sample's edges too).
+    #[cfg(feature = "alloc")]
+    pub fn restrict(&mut self, offset: [usize; 3], own: [(usize, usize); 3]) {
+        let dims = self.grid.dims;
+        self.grid.offset = offset;
+        self.grid.own_cubes = own;
+        self.grid.own_edges = core::array::from_fn(|d| {
+            (
+                own[d].0,
+                if own[d].1 + 1 == dims[d] {
+                    dims[d]
+                } else {
+                    own[d].1
+                },
+            )
+        });
     }
 
     pub fn stats(&self) -> Stats {
@@ -146,7 +176,10 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         }
         self.z_vertices(k, src, sink)?;
         self.plane_vertices(k + 1, src, sink)?;
-        self.triangles(k, sink);
+        let (own_lo, own_hi) = self.grid.own_cubes[2];
+        if (own_lo..own_hi).contains(&k) {
+            self.triangles(k, sink);
+        }
         if self.out.emit {
             // Layers done since this sweep started, and the ones left, extrapolate the output.
             let done = (k + 1 - self.first_layer) as u64;
@@ -187,7 +220,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         for y in 0..ny {
             let row = grid.row(n, y);
             let (lo, hi) = grid.span(grid.slice_row(n, y));
-            let x_grey = y % 2 == 1 && n % 2 == 1;
+            let [px, py, pz] = grid.offset.map(|o| o & 1);
+            let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
             for_each_differing(row, &row[1..], lo, hi, |x| {
                 let id = out.edge_vertex(grid, params, [x, y, n], 0, x_grey, &field, sink)?;
                 out.ids[xbase + y * nx + x] = id;
@@ -197,7 +231,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let next = grid.row(n, y + 1);
                 let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
                 for_each_differing(row, next, start, end, |x| {
-                    let grey = x % 2 == 1 && n.is_multiple_of(2);
+                    let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
                     let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
                     out.ids[ybase + y * nx + x] = id;
                     Ok(())
@@ -218,11 +252,12 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let field = self.field(src, k, k + 1);
         let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
         let zbase = 4 * nx * ny;
+        let [px, py, _] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
             let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
             let (start, end) = grid.union_span(&[(y, k), (y, k + 1)]);
             for_each_differing(below, above, start, end, |x| {
-                let grey = x % 2 == 0 && y % 2 == 0;
+                let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
                 let id = out.edge_vertex(grid, params, [x, y, k], 2, grey, &field, sink)?;
                 out.ids[zbase + y * nx + x] = id;
                 Ok(())
@@ -253,15 +288,18 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let stats = &mut self.out.stats;
         let merging = grid.mode != Mode::Steps123;
         let entries = grid.entries;
-        for j in 0..ny - 1 {
+        let [ox, oy, oz] = grid.offset;
+        let [(x_lo, x_hi), (y_lo, y_hi), _] = grid.own_cubes;
+        for j in y_lo..y_hi {
             let (start, end) = grid.span(grid.case_row(k, j));
             let cases = &grid.cases[(k % 3) * nxy + j * nx..][..nx];
-            let class_jk = (j & 1) << 1 | (k & 1) << 2;
+            let class_jk = ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
+            let (start, end) = (start.max(x_lo), end.min(x_hi));
             for (i, &case) in cases.iter().enumerate().take(end).skip(start) {
                 if case == 0 || case == 255 {
                     continue;
                 }
-                let class = (i & 1) | class_jk;
+                let class = ((i + ox) & 1) | class_jk;
                 let entry = &entries[class * 256 + usize::from(case)];
                 stats.t13 += u64::from(entry.count);
                 let at = i + nx * j;
@@ -283,7 +321,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
                         stats.triangles += 1;
-                        sink.triangle(grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at));
+                        let t = grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at);
+                        sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
                 }
                 let mut kept = ((1u16 << entry.count) - 1) as u8 & !dropped;
@@ -291,7 +330,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                     let n = kept.trailing_zeros() as usize;
                     kept &= kept - 1;
                     stats.triangles += 1;
-                    sink.triangle(entry.tris[n].map(id));
+                    sink.cube_triangle([i + ox, j + oy, k + oz], entry.tris[n].map(id));
                 }
             }
         }
@@ -350,7 +389,8 @@ impl Out<'_> {
         } else {
             Decision::Keep
         };
-        if self.emit {
+        let counted = self.emit && grid.owns_edge(p);
+        if counted {
             self.stats.v13 += 1;
             self.stats.merged += u64::from(decision == Decision::Merge);
             self.stats.blocked += u64::from(decision == Decision::Blocked);
@@ -364,7 +404,7 @@ impl Out<'_> {
         }
         self.next_id += 1;
         if self.emit {
-            self.stats.vertices += 1;
+            self.stats.vertices += u64::from(counted);
             let mut q = p;
             q[axis] += 1;
             let (a, b) = (field.value(p), field.value(q));
@@ -373,14 +413,15 @@ impl Out<'_> {
             } else {
                 crossing(a, b, params.iso)
             };
+            let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
             let pos: [f32; 3] = core::array::from_fn(|d| {
-                let c = p[d] as f64 + if d == axis { t } else { 0.0 };
+                let c = global[d] as f64 + if d == axis { t } else { 0.0 };
                 (params.origin[d] + c * params.spacing[d]) as f32
             });
             let normal = params
                 .normals
                 .then(|| field.normal(p, axis, t, grid.is_filled(p)));
-            sink.vertex(pos, normal);
+            sink.edge_vertex(global, axis, pos, normal);
         }
         Ok(id)
     }
@@ -390,6 +431,12 @@ impl Grid<'_> {
     fn row(&self, z: usize, y: usize) -> &[u8] {
         let [nx, ny, _] = self.dims;
         &self.filled[(z % 4) * nx * ny + y * nx..][..nx]
+    }
+
+    /// Whether this sweep counts the edge with lower end `p` (see [`Sweep::restrict`]).
+    #[inline]
+    fn owns_edge(&self, p: [usize; 3]) -> bool {
+        (0..3).all(|d| (self.own_edges[d].0..self.own_edges[d].1).contains(&p[d]))
     }
 
     fn is_filled(&self, p: [usize; 3]) -> bool {
@@ -514,8 +561,9 @@ impl Grid<'_> {
         if self.mode == Mode::Paper {
             return Decision::Merge;
         }
+        let [ox, oy, oz] = self.offset;
         let mergeable = cubes.iter().all(|&(i, j, k)| {
-            let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
+            let class = ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
             self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis & 1 == 1
         });
         if mergeable && !self.pinch(p, axis) {
@@ -585,10 +633,11 @@ impl Grid<'_> {
         entry: &Entry,
         edge_at: &[usize; 12],
     ) -> [u32; 3] {
-        let along_y = axis == 0 || (axis == 2 && k % 2 == 0);
+        let [ox, oy, oz] = self.offset;
+        let along_y = axis == 0 || (axis == 2 && (k + oz) % 2 == 0);
         let (pi, pj) = if along_y { (i, j + 1) } else { (i + 1, j) };
         let nx = self.dims[0];
-        let pclass = (pi & 1) | (pj & 1) << 1 | (k & 1) << 2;
+        let pclass = ((pi + ox) & 1) | ((pj + oy) & 1) << 1 | ((k + oz) & 1) << 2;
         let pentry = &self.entries[pclass * 256 + usize::from(self.case_at(pi, pj, k))];
         // An ear is stored `[back, grey, forward]`: only its two outer vertices matter.
         let outer = |e: &Entry, at: usize| {

@@ -1,0 +1,353 @@
+//! Meshing a grid block by block — on other threads, processes or machines — into exactly the
+//! mesh one sweep makes.
+//!
+//! Every decision of Steps 1–4 is local (SPEC §5), so a block's triangles follow from its samples
+//! plus a thin halo, and vertices have global names: the grid edge they lie on. A block owns the
+//! triangles its cubes emit (a merged pair's triangle belongs to the pair's lower cube, which the
+//! sweep already makes its emitter), so every triangle of the whole mesh belongs to exactly one
+//! block. Joining blocks is then a merge of sorted lists: vertex keys are numbered in the order a
+//! sweep numbers vertices, and triangles are ordered by owning cube, so the joined mesh is
+//! byte-identical to [`crate::extract`]'s whatever the block shapes and the order of arrival.
+
+use alloc::vec::Vec;
+use core::ops::Range;
+
+use crate::extract::InMemory;
+use crate::mesh::OwnedScratch;
+use crate::sweep::Sweep;
+use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
+
+/// The samples meshing the cubes `cubes` (lower corners, per axis) of a grid of `grid` samples
+/// reads: one sample before the block and two past its far corners, clipped to the grid. The
+/// halo may start at any index: the sweep takes parity classes from global indices.
+///
+/// Why that much: a cube's triangles depend on the Step 4 decisions of its grey edges, which read
+/// the cases of the four cubes around each edge and the pinch test's neighbours one sample out;
+/// and the cube that owns a merged pair emits its partner's ear too, so the partner one cube
+/// further along x or y counts as well. Normals' central differences stay within that reach.
+///
+/// ```
+/// use sc_runtime::block_samples;
+///
+/// assert_eq!(block_samples([100, 100, 100], [10..20, 0..99, 97..99]).unwrap(), [9..23, 0..100, 96..100]);
+/// ```
+pub fn block_samples(
+    grid: [usize; 3],
+    cubes: [Range<usize>; 3],
+) -> Result<[Range<usize>; 3], Error> {
+    check_cubes(grid, &cubes)?;
+    Ok(core::array::from_fn(|d| {
+        let lo = cubes[d].start.saturating_sub(1);
+        lo..(cubes[d].end + 3).min(grid[d])
+    }))
+}
+
+fn check_cubes(grid: [usize; 3], cubes: &[Range<usize>; 3]) -> Result<(), Error> {
+    for (d, r) in cubes.iter().enumerate() {
+        if r.start > r.end || r.end > grid[d].saturating_sub(1) {
+            return Err(Error::BlockOutsideGrid {
+                axis: d,
+                cubes: r.clone(),
+                grid: grid[d],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The global name of a grid edge: its lower end and axis packed into one number, ordered the way
+/// a sweep numbers vertices (by plane, x- then y-edges row by row, then the plane's z-edges), so
+/// that sorting vertices by key gives [`crate::extract`]'s vertex order.
+///
+/// ```
+/// use sc_runtime::edge_key;
+///
+/// let grid = [4, 3, 2];
+/// // Plane 0: row 0's x-edges, row 0's y-edges, row 1's x-edges, …; then plane 0's z-edges.
+/// assert!(edge_key(grid, [3, 0, 0], 0) < edge_key(grid, [0, 0, 0], 1));
+/// assert!(edge_key(grid, [3, 0, 0], 1) < edge_key(grid, [0, 1, 0], 0));
+/// assert!(edge_key(grid, [3, 2, 0], 0) < edge_key(grid, [0, 0, 0], 2));
+/// assert!(edge_key(grid, [3, 2, 0], 2) < edge_key(grid, [0, 0, 1], 0));
+/// ```
+pub fn edge_key(grid: [usize; 3], lower: [usize; 3], axis: usize) -> u64 {
+    let [nx, ny, _] = grid.map(|n| n as u64);
+    let [x, y, z] = lower.map(|c| c as u64);
+    let (group, row_part) = match axis {
+        0 => (0, 0),
+        1 => (0, 1),
+        _ => (1, 0),
+    };
+    (((z * 2 + group) * ny + y) * 2 + row_part) * nx + x
+}
+
+/// The global name of a cube (by its lower corner), in the order a sweep visits cubes.
+fn cube_key(grid: [usize; 3], [i, j, k]: [usize; 3]) -> u64 {
+    let [nx, ny, _] = grid.map(|n| n as u64);
+    ((k as u64) * ny + j as u64) * nx + i as u64
+}
+
+/// One block's share of the mesh: the triangles its cubes own, over the vertices they use, named
+/// by global edge keys. Join shares with [`BlockMesh::merge`] (in any order or tree) and finish
+/// with [`BlockMesh::into_mesh`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BlockMesh {
+    /// Samples of the whole grid along x, y, z.
+    pub grid: [usize; 3],
+    /// Global edge keys ([`edge_key`]) of the vertices, strictly increasing.
+    pub keys: Vec<u64>,
+    /// Vertex positions in world units, one per key.
+    pub positions: Vec<[f32; 3]>,
+    /// Unit normals, one per key, or empty when normals were not asked for.
+    pub normals: Vec<[f32; 3]>,
+    /// Triangles as indices into `keys`, wound as [`Mesh::triangles`].
+    pub triangles: Vec<[u32; 3]>,
+    /// Per triangle, the key of the cube that owns it; non-decreasing.
+    pub cubes: Vec<u64>,
+    /// The counts of the owned cubes and edges; they add up across blocks.
+    pub stats: Stats,
+    /// Cubes owned, so that [`BlockMesh::into_mesh`] can tell a whole grid from a partial one.
+    pub covered: u64,
+}
+
+/// Collects a block sweep's output with global names; the sweep numbers vertices in key order.
+struct Collect {
+    grid: [usize; 3],
+    keys: Vec<u64>,
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+    cubes: Vec<u64>,
+}
+
+impl Sink for Collect {
+    fn vertex(&mut self, _: [f32; 3], _: Option<[f32; 3]>) {
+        unreachable!("the sweep names every vertex through edge_vertex")
+    }
+
+    fn triangle(&mut self, _: [u32; 3]) {
+        unreachable!("the sweep places every triangle through cube_triangle")
+    }
+
+    fn edge_vertex(
+        &mut self,
+        lower: [usize; 3],
+        axis: usize,
+        position: [f32; 3],
+        normal: Option<[f32; 3]>,
+    ) {
+        self.keys.push(edge_key(self.grid, lower, axis));
+        self.positions.push(position);
+        self.normals.extend(normal);
+    }
+
+    fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {
+        self.cubes.push(cube_key(self.grid, cube));
+        self.triangles.push(triangle);
+    }
+}
+
+/// Meshes the cubes `cubes` (lower corners, per axis, in global indices) of a grid of `grid`
+/// samples. `samples` holds the samples of a box starting at global index `at`, which must cover
+/// [`block_samples`]; a box that is too small is refused rather than meshed wrongly.
+///
+/// ```
+/// use sc_runtime::{BlockMesh, Params, Volume, block_samples, demo, extract, extract_block};
+///
+/// let v = demo::torus(24);
+/// let params = Params::new(v.iso);
+/// let [nx, ny, nz] = v.dims;
+/// let mut joined = BlockMesh::default();
+/// for z in [0..11, 11..nz - 1] {
+///     let cubes = [0..nx - 1, 0..ny - 1, z];
+///     let need = block_samples(v.dims, cubes.clone()).unwrap();
+///     let box_ = &v.data[need[2].start * nx * ny..need[2].end * nx * ny];
+///     let dims = [nx, ny, need[2].len()];
+///     let part = extract_block(&Volume::new(box_, dims).unwrap(), [0, 0, need[2].start], v.dims, cubes, &params).unwrap();
+///     joined = joined.merge(part).unwrap();
+/// }
+/// let whole = extract(&Volume::new(&v.data, v.dims).unwrap(), &params).unwrap();
+/// assert_eq!(joined.into_mesh().unwrap(), whole);
+/// ```
+pub fn extract_block<T: Scalar>(
+    samples: &Volume<'_, T>,
+    at: [usize; 3],
+    grid: [usize; 3],
+    cubes: [Range<usize>; 3],
+    params: &Params,
+) -> Result<BlockMesh, Error> {
+    let need = block_samples(grid, cubes.clone())?;
+    let dims = samples.dims();
+    for d in 0..3 {
+        let have = at[d]..at[d].saturating_add(dims[d]);
+        if have.start > need[d].start || have.end < need[d].end || have.end > grid[d] {
+            return Err(Error::HaloTooSmall {
+                axis: d,
+                have,
+                need: need[d].clone(),
+            });
+        }
+    }
+    let mut out = BlockMesh {
+        grid,
+        covered: cubes.iter().map(|r| r.len() as u64).product(),
+        ..BlockMesh::default()
+    };
+    if out.covered == 0 {
+        return Ok(out);
+    }
+    let mut collect = Collect {
+        grid,
+        keys: Vec::new(),
+        positions: Vec::new(),
+        normals: Vec::new(),
+        triangles: Vec::new(),
+        cubes: Vec::new(),
+    };
+    let mut scratch = OwnedScratch::new(dims)?;
+    let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
+    sweep.restrict(
+        at,
+        core::array::from_fn(|d| (cubes[d].start - at[d], cubes[d].end - at[d])),
+    );
+    let src = InMemory {
+        data: samples.data(),
+        nxy: dims[0] * dims[1],
+    };
+    sweep.start(0, &src, &mut collect, true)?;
+    for k in 0..dims[2] - 1 {
+        sweep.layer(k, &src, &mut collect)?;
+    }
+    out.stats = sweep.stats();
+    // Keep the vertices the owned triangles use; the halo's others belong to other blocks.
+    let mut new_id = alloc::vec![u32::MAX; collect.keys.len()];
+    for t in &collect.triangles {
+        for &v in t {
+            new_id[v as usize] = 0;
+        }
+    }
+    let mut next = 0;
+    for (v, id) in new_id.iter_mut().enumerate() {
+        if *id == 0 {
+            *id = next;
+            next += 1;
+            out.keys.push(collect.keys[v]);
+            out.positions.push(collect.positions[v]);
+            if let Some(&n) = collect.normals.get(v) {
+                out.normals.push(n);
+            }
+        }
+    }
+    out.triangles = collect
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| new_id[v as usize]))
+        .collect();
+    out.cubes = collect.cubes;
+    Ok(out)
+}
+
+impl BlockMesh {
+    /// Joins two shares of the same grid into one: the union of their vertices (in key order)
+    /// and of their triangles (in cube order). Associative and commutative, so shares can be
+    /// joined in any order or as a tree. Shares that own the same cube are refused.
+    pub fn merge(self, other: BlockMesh) -> Result<BlockMesh, Error> {
+        if self.covered == 0 && self.keys.is_empty() {
+            return Ok(other);
+        }
+        if other.covered == 0 && other.keys.is_empty() {
+            return Ok(self);
+        }
+        if self.grid != other.grid
+            || (self.normals.is_empty() != other.normals.is_empty()
+                && !self.keys.is_empty()
+                && !other.keys.is_empty())
+        {
+            return Err(Error::BlocksDiffer);
+        }
+        let (a, b) = (self, other);
+        let mut out = BlockMesh {
+            grid: a.grid,
+            stats: a.stats + b.stats,
+            covered: a.covered + b.covered,
+            ..BlockMesh::default()
+        };
+        // Union of the sorted keys, with each side's old index → new index.
+        let (mut map_a, mut map_b) = (
+            Vec::with_capacity(a.keys.len()),
+            Vec::with_capacity(b.keys.len()),
+        );
+        let (mut i, mut j) = (0, 0);
+        while i < a.keys.len() || j < b.keys.len() {
+            let next = out.keys.len() as u32;
+            let (ka, kb) = (a.keys.get(i), b.keys.get(j));
+            let take_a = kb.is_none_or(|kb| ka.is_some_and(|ka| ka <= kb));
+            let take_b = ka.is_none_or(|ka| kb.is_some_and(|kb| kb <= ka));
+            let (src, at) = if take_a { (&a, i) } else { (&b, j) };
+            if take_a && take_b && a.positions[i] != b.positions[j] {
+                return Err(Error::BlocksDiffer);
+            }
+            out.keys.push(src.keys[at]);
+            out.positions.push(src.positions[at]);
+            if let Some(&n) = src.normals.get(at) {
+                out.normals.push(n);
+            }
+            if take_a {
+                map_a.push(next);
+                i += 1;
+            }
+            if take_b {
+                map_b.push(next);
+                j += 1;
+            }
+        }
+        // Triangles by owning cube; a cube's triangles all come from one side, in their order.
+        out.triangles.reserve(a.triangles.len() + b.triangles.len());
+        out.cubes.reserve(a.cubes.len() + b.cubes.len());
+        let (mut i, mut j) = (0, 0);
+        while i < a.cubes.len() || j < b.cubes.len() {
+            let (ca, cb) = (a.cubes.get(i), b.cubes.get(j));
+            if let (Some(ca), Some(cb)) = (ca, cb)
+                && ca == cb
+            {
+                return Err(Error::BlocksOverlap { cube: *ca });
+            }
+            let take_a = cb.is_none_or(|cb| ca.is_some_and(|ca| ca < cb));
+            let (side, map, at) = if take_a {
+                i += 1;
+                (&a, &map_a, i - 1)
+            } else {
+                j += 1;
+                (&b, &map_b, j - 1)
+            };
+            out.cubes.push(side.cubes[at]);
+            out.triangles
+                .push(side.triangles[at].map(|v| map[v as usize]));
+        }
+        Ok(out)
+    }
+
+    /// The whole mesh, once the shares joined cover every cube of the grid: exactly what
+    /// [`crate::extract`] gives for the whole grid.
+    pub fn into_mesh(self) -> Result<Mesh, Error> {
+        let need: u64 = self
+            .grid
+            .iter()
+            .map(|&n| n.saturating_sub(1) as u64)
+            .product();
+        if self.covered != need {
+            return Err(Error::BlocksMissing {
+                covered: self.covered,
+                cubes: need,
+            });
+        }
+        if u32::try_from(self.keys.len()).is_err() {
+            return Err(Error::TooManyVertices);
+        }
+        Ok(Mesh {
+            positions: self.positions,
+            normals: self.normals,
+            triangles: self.triangles,
+            stats: self.stats,
+        })
+    }
+}
