@@ -2,6 +2,7 @@
 //! copies, the GIL released while the Rust extractor runs, errors as Python exceptions. The
 //! NumPy-facing conveniences (`marching_cubes`, `Mesh`) are Python, in `python/skelclimb`.
 
+mod blocks;
 mod convert;
 mod errors;
 mod extract;
@@ -15,6 +16,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(extract::extract, m)?)?;
     m.add_function(wrap_pyfunction!(files::save, m)?)?;
     m.add_function(wrap_pyfunction!(files::load, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::extract_block, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::merge_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::finish_blocks, m)?)?;
     m.add_class::<streamer::SliceStreamer>()?;
     Ok(())
 }

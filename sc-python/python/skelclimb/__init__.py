@@ -22,7 +22,16 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["Mesh", "SliceStreamer", "extract", "load", "marching_cubes"]
+__all__ = [
+    "BlockMesh",
+    "Mesh",
+    "SliceStreamer",
+    "block_samples",
+    "extract",
+    "extract_block",
+    "load",
+    "marching_cubes",
+]
 
 _MODES = ("embedded", "paper", "steps123")
 
@@ -275,4 +284,5 @@ class SliceStreamer:
         return Mesh(verts, faces, norms, stats)
 
 
+from ._blocks import BlockMesh, block_samples, extract_block  # noqa: E402  (needs Mesh above)
 from ._skimage import marching_cubes  # noqa: E402  (needs extract above)

@@ -77,3 +77,28 @@ class SliceStreamer:
     ) -> None: ...
     def push(self, slice: npt.NDArray[Any]) -> None: ...
     def finish(self) -> Mesh: ...
+
+class BlockMesh:
+    mode: _Mode
+    level: float
+    normals: bool
+    @property
+    def triangles(self) -> int: ...
+    def merge(self, *others: BlockMesh) -> BlockMesh: ...
+    def to_mesh(self) -> Mesh: ...
+
+def block_samples(
+    grid: Sequence[int], cubes: Sequence[Tuple[int, int]]
+) -> Tuple[Tuple[int, int], Tuple[int, int], Tuple[int, int]]: ...
+def extract_block(
+    samples: npt.NDArray[Any],
+    level: float,
+    *,
+    at: Sequence[int],
+    grid: Sequence[int],
+    cubes: Sequence[Tuple[int, int]],
+    spacing: _Triple = ...,
+    origin: _Triple = ...,
+    mode: _Mode = ...,
+    normals: bool = ...,
+) -> BlockMesh: ...

@@ -1,0 +1,167 @@
+"""Block extraction and the Dask driver: shares joined in any order, and meshes computed one task
+per chunk on threads or on a cluster of processes (with a worker killed mid-run), equal
+``skelclimb.extract`` of the whole volume exactly."""
+
+import doctest
+import os
+import random
+import sys
+
+import cloudpickle
+import dask
+import dask.array as da
+import distributed
+import numpy as np
+import pytest
+import zarr
+
+import skelclimb
+import skelclimb._blocks
+import skelclimb.dask
+
+MODES = ("embedded", "paper", "steps123")
+
+
+def blobs(shape, seed):
+    """Smooth random blobs with integer ties: a surface with many merges and pinches."""
+    rng = np.random.default_rng(seed)
+    z, y, x = np.indices(shape, dtype=np.float32)
+    f = np.zeros(shape, np.float32)
+    for _ in range(6):
+        c = rng.uniform(0, 1, 3) * np.array(shape)
+        r = rng.uniform(0.15, 0.35) * min(shape)
+        f += np.exp(-((z - c[0]) ** 2 + (y - c[1]) ** 2 + (x - c[2]) ** 2) / (r * r))
+    return np.round(f * 40).astype(np.int16)
+
+
+def same(a, b):
+    assert a.stats == b.stats
+    assert np.array_equal(a.vertices, b.vertices)
+    assert np.array_equal(a.faces, b.faces)
+    if a.normals is None or b.normals is None:
+        assert a.normals is None and b.normals is None
+    else:
+        assert np.array_equal(a.normals, b.normals)
+
+
+def test_docstring_examples_run():
+    for module in (skelclimb, skelclimb._blocks, skelclimb.dask):
+        failed, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+        assert failed == 0, module.__name__
+        assert tried > 0, module.__name__
+
+
+def cut(n, rng):
+    """Random cube ranges covering ``0 .. n - 1``, some one to three cubes wide."""
+    edges = sorted({0, n - 1, *rng.sample(range(1, n - 1), k=min(4, n - 2))})
+    return list(zip(edges, edges[1:]))
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_shares_joined_in_any_order_equal_extract(mode):
+    rng = random.Random(7)
+    v = blobs((23, 21, 19), 1)
+    level = 12
+    grid = v.shape[::-1]
+    for trial in range(4):
+        parts = []
+        for cz in cut(grid[2], rng):
+            for cy in cut(grid[1], rng):
+                for cx in cut(grid[0], rng):
+                    cubes = (cx, cy, cz)
+                    (x0, x1), (y0, y1), (z0, z1) = skelclimb.block_samples(grid, cubes)
+                    parts.append(skelclimb.extract_block(
+                        v[z0:z1, y0:y1, x0:x1], level, at=(x0, y0, z0), grid=grid,
+                        cubes=cubes, mode=mode, spacing=(0.5, 1, 2), origin=(1, 2, 3)))
+        rng.shuffle(parts)
+        while len(parts) > 1:
+            k = rng.randint(2, 4)
+            parts = [parts[0].merge(*parts[1:k]), *parts[k:]]
+            rng.shuffle(parts)
+        whole = skelclimb.extract(v, level, mode=mode, spacing=(0.5, 1, 2), origin=(1, 2, 3))
+        assert whole.faces.shape[0] > 100
+        same(parts[0].to_mesh(), whole)
+
+
+def test_block_errors_are_value_errors():
+    v = blobs((12, 12, 12), 2)
+    grid = (12, 12, 12)
+    cubes = ((2, 6), (0, 11), (0, 11))
+    # One sample short before the block along x.
+    with pytest.raises(ValueError, match="do not cover"):
+        skelclimb.extract_block(v[:, :, 2:9], 12, at=(2, 0, 0), grid=grid, cubes=cubes)
+    with pytest.raises(ValueError, match="cubes"):
+        skelclimb.block_samples(grid, ((0, 12), (0, 11), (0, 11)))
+    half = skelclimb.extract_block(v, 12, at=(0, 0, 0), grid=grid, cubes=cubes)
+    with pytest.raises(ValueError, match="cover"):
+        half.to_mesh()
+    other = skelclimb.extract_block(v, 13, at=(0, 0, 0), grid=grid,
+                                    cubes=((6, 11), (0, 11), (0, 11)))
+    with pytest.raises(ValueError, match="different settings"):
+        half.merge(other)
+    with pytest.raises(ValueError, match="own"):
+        half.merge(half)
+
+
+@pytest.mark.parametrize("normals", [True, False])
+def test_dask_threads_with_uneven_chunks(normals):
+    v = blobs((40, 37, 33), 3)
+    arr = da.from_array(v, chunks=((7, 1, 20, 12), (16, 16, 5), (2, 31)))
+    with dask.config.set(scheduler="threads"):
+        got = skelclimb.dask.extract(arr, 12, normals=normals, split_every=3)
+    same(got, skelclimb.extract(v, 12, normals=normals))
+
+
+def test_dask_checks_its_arguments():
+    arr = da.zeros((4, 4), chunks=2)
+    with pytest.raises(ValueError, match="3 dimensions"):
+        skelclimb.dask.extract(arr, 0.5)
+    with pytest.raises(ValueError, match="level"):
+        skelclimb.dask.extract(da.zeros((4, 4, 4), chunks=2), float("nan"))
+
+
+def _die_once(block, marker):
+    """Kills the worker process running it, the first time any worker runs it."""
+    try:
+        os.close(os.open(marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        return block
+    os._exit(1)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    # Workers are fresh processes that cannot import this test module: send its functions.
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as c, distributed.Client(c) as client:
+        yield client
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    v = blobs((150, 140, 130), 4)
+    path = str(tmp_path_factory.mktemp("zarr") / "blobs.zarr")
+    z = zarr.create_array(store=path, shape=v.shape, chunks=(64, 64, 64), dtype=v.dtype)
+    z[:] = v
+    return path, v
+
+
+def test_cluster_of_two_processes_meshes_a_zarr_store_exactly(cluster, store):
+    path, v = store
+    arr = da.from_zarr(path)
+    assert arr.chunksize == (64, 64, 64)
+    got = skelclimb.dask.extract(arr, 12)
+    same(got, skelclimb.extract(v, 12))
+    # Both workers took part.
+    assert len(cluster.scheduler_info()["workers"]) == 2
+
+
+def test_a_killed_worker_is_retried_and_the_mesh_is_still_exact(cluster, store, tmp_path):
+    path, v = store
+    marker = str(tmp_path / "died")
+    # `meta` keeps Dask from calling the function here to learn its output type.
+    arr = da.from_zarr(path).map_blocks(_die_once, marker, meta=np.empty((0, 0, 0), v.dtype))
+    got = skelclimb.dask.extract(arr, 12, mode="paper")
+    assert os.path.exists(marker), "a worker was killed"
+    same(got, skelclimb.extract(v, 12, mode="paper"))
