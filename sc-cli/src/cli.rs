@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use sc_runtime::Mode;
+use sc_runtime::{ErrorBound, Mode};
 
 use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
@@ -119,6 +119,16 @@ pub struct ExtractArgs {
     /// `paper` merges every interior grey edge as the paper does, `steps123` does not merge.
     #[arg(long, value_enum, default_value_t = ModeArg::Embedded)]
     pub mode: ModeArg,
+    /// Merge a grey edge only if the vertex it removes lies closer than this to the two
+    /// triangles that replace its four: a bound on how far Step 4 moves the surface, in the
+    /// volume's world units (mm for most scans) or, with `--error-units voxels`, in grid steps.
+    /// 0 merges nothing (Steps 1–3's triangles); no bound (the default) merges what the mode
+    /// allows.
+    #[arg(long, value_parser = parse_max_error)]
+    pub max_error: Option<f64>,
+    /// The units of `--max-error`.
+    #[arg(long, value_enum, default_value_t = ErrorUnits::World, requires = "max_error")]
+    pub error_units: ErrorUnits,
     /// Leave out per-vertex normals.
     #[arg(long)]
     pub no_normals: bool,
@@ -242,6 +252,25 @@ impl From<ModeArg> for Mode {
     }
 }
 
+/// `--error-units` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ErrorUnits {
+    /// The volume's world units: spacing × index, usually mm.
+    World,
+    /// Grid steps, whatever the spacing.
+    Voxels,
+}
+
+impl ExtractArgs {
+    /// The bound `--max-error` and `--error-units` ask for.
+    pub fn error_bound(&self) -> Option<ErrorBound> {
+        self.max_error.map(|d| match self.error_units {
+            ErrorUnits::World => ErrorBound::World(d),
+            ErrorUnits::Voxels => ErrorBound::Voxels(d),
+        })
+    }
+}
+
 /// An output path whose extension names a known mesh format.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Output {
@@ -293,6 +322,15 @@ fn parse_size(s: &str) -> Result<usize, String> {
         return Err("the built-in volumes have 2 to 512 samples per axis".into());
     }
     Ok(n)
+}
+
+fn parse_max_error(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err("the bound must be a finite number, 0 or more".into())
+    }
 }
 
 fn parse_iso(s: &str) -> Result<f64, String> {

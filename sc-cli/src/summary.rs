@@ -3,7 +3,7 @@
 use std::fmt;
 use std::time::Duration;
 
-use sc_runtime::{Mode, Stats};
+use sc_runtime::{ErrorBound, Mode, Stats};
 use serde_json::{Value, json};
 
 use crate::check::EdgeReport;
@@ -30,6 +30,8 @@ pub struct Summary {
     pub iso: f64,
     /// Which steps ran.
     pub mode: Mode,
+    /// `--max-error`, if given.
+    pub max_error: Option<ErrorBound>,
     /// Counts from the extractor.
     pub stats: Stats,
     /// Time spent reading (or generating) the volume.
@@ -92,6 +94,11 @@ impl Summary {
             "result": { "vertices": s.vertices, "triangles": s.triangles },
             "merged": s.merged,
             "blocked": s.blocked,
+            "bounded": s.bounded,
+            "max_error": self.max_error.map(|b| match b {
+                ErrorBound::World(d) => json!({ "value": d, "units": "world" }),
+                ErrorBound::Voxels(d) => json!({ "value": d, "units": "voxels" }),
+            }),
             "reduction_percent": reduction(s),
             "seconds": {
                 "read": self.read.as_secs_f64(),
@@ -143,6 +150,17 @@ impl fmt::Display for Summary {
                 thousands(s.triangles),
                 reduction(s),
                 thousands(s.merged)
+            )?;
+        }
+        if let Some(bound) = self.max_error {
+            let (d, units) = match bound {
+                ErrorBound::World(d) => (d, "world units"),
+                ErrorBound::Voxels(d) => (d, "voxels"),
+            };
+            writeln!(
+                f,
+                "  --max-error {d} {units}: {} more grey edges kept to stay within it",
+                thousands(s.bounded)
             )?;
         }
         if let Some(ours) = self.paper_knot {
@@ -197,6 +215,7 @@ mod tests {
             t13: 16,
             merged: 2,
             blocked: 0,
+            bounded: 0,
             vertices: 8,
             triangles: 12,
         };
@@ -209,6 +228,7 @@ mod tests {
             dtype: "u8",
             iso: 20.0,
             mode: Mode::Embedded,
+            max_error: None,
             stats,
             read: Duration::from_millis(5),
             extract: Duration::from_millis(7),

@@ -512,3 +512,70 @@ fn check_reports_paper_mode_non_manifold_edges() {
     let paper = report("paper");
     assert!(paper["non_manifold_edges"].as_u64().unwrap() > 0, "{paper}");
 }
+
+/// `--max-error` in world units (the itk-t1 fixture's 2 × 2 × 3 mm) and in voxels: fewer merges
+/// as the bound tightens, the kept merges reported, 0 meaning Steps 1–3's triangles; bad bounds
+/// are usage errors.
+#[test]
+fn max_error_trades_triangles_for_a_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = fixture("itk-t1-mri.nii.gz");
+    let run = |bound: &[&str]| -> serde_json::Value {
+        skelclimb()
+            .current_dir(dir.path())
+            .args([
+                "extract",
+                "--iso",
+                "20.5",
+                "-q",
+                "-o",
+                "m.ply",
+                "--stats-json",
+                "s.json",
+            ])
+            .arg(&input)
+            .args(bound)
+            .assert()
+            .success();
+        serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap()
+    };
+    let tri = |s: &serde_json::Value| s["result"]["triangles"].as_u64().unwrap();
+    let free = run(&[]);
+    assert_eq!(free["bounded"], 0);
+    assert!(free["max_error"].is_null());
+    let zero = run(&["--max-error", "0"]);
+    assert_eq!(tri(&zero), zero["steps123"]["triangles"].as_u64().unwrap());
+    assert_eq!(zero["bounded"], free["merged"]);
+    let mm = run(&["--max-error", "0.5"]);
+    assert_eq!(
+        mm["max_error"],
+        serde_json::json!({ "value": 0.5, "units": "world" })
+    );
+    // Half a millimetre is a quarter of the finest spacing: tighter than 0.5 voxel.
+    let vox = run(&["--max-error", "0.5", "--error-units", "voxels"]);
+    assert!(tri(&free) < tri(&vox) && tri(&vox) < tri(&mm) && tri(&mm) < tri(&zero));
+    for (name, s) in [("mm", &mm), ("vox", &vox)] {
+        assert_eq!(
+            s["merged"].as_u64().unwrap() + s["bounded"].as_u64().unwrap(),
+            free["merged"].as_u64().unwrap(),
+            "{name}: the bound only turns merges into kept edges"
+        );
+    }
+    for bad in ["-1", "nan", "inf", "x"] {
+        skelclimb()
+            .current_dir(dir.path())
+            .args([
+                "extract",
+                "--iso",
+                "20.5",
+                "-o",
+                "bad.ply",
+                "--max-error",
+                bad,
+            ])
+            .arg(&input)
+            .assert()
+            .code(2);
+    }
+    assert!(!dir.path().join("bad.ply").exists());
+}

@@ -1,6 +1,6 @@
 //! The bridge from a typed [`Grid`] to the generic extractor.
 
-use sc_runtime::{Mesh, Mode, Params, Volume, extract_par};
+use sc_runtime::{ErrorBound, Mesh, Mode, Params, Volume, extract_par};
 
 use crate::error::Result;
 use crate::progress::Progress;
@@ -21,6 +21,8 @@ pub struct Request {
     pub threads: usize,
     /// Which coordinates the mesh is in.
     pub coordinates: Coordinates,
+    /// The bound on Step 4's displacement of the surface, if any.
+    pub max_error: Option<ErrorBound>,
 }
 
 impl Request {
@@ -32,6 +34,7 @@ impl Request {
             normals: true,
             threads: 0,
             coordinates: Coordinates::Native,
+            max_error: None,
         }
     }
 }
@@ -49,6 +52,7 @@ pub fn extract(grid: &Grid, request: &Request, progress: &dyn Progress) -> Resul
     params.mode = request.mode;
     params.normals = request.normals;
     params.spacing = grid.spacing;
+    params.max_error = request.max_error;
     if world.is_translation() {
         params.origin = world.offset;
     }

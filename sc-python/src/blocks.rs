@@ -13,7 +13,7 @@ use crate::errors;
 use crate::extract::params;
 
 /// A share as Python sees it: `(grid, keys, positions, normals, faces, cubes, counts, covered)`,
-/// with `normals` empty when not asked for and `counts` the six `Stats` fields in order.
+/// with `normals` empty when not asked for and `counts` the seven `Stats` fields in order.
 type Share<'py> = (
     [usize; 3],
     Bound<'py, PyArray1<u64>>,
@@ -21,14 +21,14 @@ type Share<'py> = (
     Bound<'py, numpy::PyArray2<f32>>,
     Bound<'py, numpy::PyArray2<u32>>,
     Bound<'py, PyArray1<u64>>,
-    [u64; 6],
+    [u64; 7],
     u64,
 );
 
 /// Meshes the cubes `cubes` (`(start, end)` per axis, x, y, z) of a grid of `grid` samples from
 /// `samples`, a 3-D array whose first sample sits at global index `at`.
 #[pyfunction]
-#[pyo3(signature = (samples, at, grid, cubes, level, spacing, origin, mode, normals))]
+#[pyo3(signature = (samples, at, grid, cubes, level, spacing, origin, mode, normals, max_error=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn extract_block<'py>(
     py: Python<'py>,
@@ -41,8 +41,9 @@ pub fn extract_block<'py>(
     origin: [f64; 3],
     mode: &str,
     normals: bool,
+    max_error: Option<(f64, String)>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let params = params(level, spacing, origin, mode, normals)?;
+    let params = params(level, spacing, origin, mode, normals, max_error)?;
     let dims = convert::dims(samples, "samples")?;
     let cubes = cubes.map(|(a, b)| a..b);
     let share = with_element!(py, samples, "samples", T => run::<T>(py, samples, dims, at, grid, cubes.clone(), &params))?;
@@ -107,8 +108,16 @@ pub fn finish_blocks<'py>(
         .into_pyobject(py)
 }
 
-fn counts(s: &Stats) -> [u64; 6] {
-    [s.v13, s.t13, s.merged, s.blocked, s.vertices, s.triangles]
+fn counts(s: &Stats) -> [u64; 7] {
+    [
+        s.v13,
+        s.t13,
+        s.merged,
+        s.blocked,
+        s.bounded,
+        s.vertices,
+        s.triangles,
+    ]
 }
 
 fn to_python(py: Python<'_>, b: BlockMesh) -> PyResult<Share<'_>> {
@@ -134,7 +143,7 @@ fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
         PyReadonlyArray2<'_, f32>,
         PyReadonlyArray2<'_, u32>,
         PyReadonlyArray1<'_, u64>,
-        [u64; 6],
+        [u64; 7],
         u64,
     ) = obj
         .extract()
@@ -169,8 +178,9 @@ fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
             t13: c[1],
             merged: c[2],
             blocked: c[3],
-            vertices: c[4],
-            triangles: c[5],
+            bounded: c[4],
+            vertices: c[5],
+            triangles: c[6],
         },
         covered,
     })

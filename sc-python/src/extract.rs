@@ -4,7 +4,7 @@ use numpy::{Element, PyUntypedArray};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sc_runtime::{Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
+use sc_runtime::{ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
 
 use crate::convert::{self, with_element};
 use crate::errors;
@@ -21,6 +21,25 @@ pub fn mode(name: &str) -> PyResult<Mode> {
     }
 }
 
+/// Parses `max_error` and `error_units` as `(value, units)`.
+fn bound(bound: Option<(f64, String)>) -> PyResult<Option<ErrorBound>> {
+    let Some((d, units)) = bound else {
+        return Ok(None);
+    };
+    if !(d.is_finite() && d >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "max_error: must be a finite number, 0 or more, got {d}"
+        )));
+    }
+    match units.as_str() {
+        "world" => Ok(Some(ErrorBound::World(d))),
+        "voxels" => Ok(Some(ErrorBound::Voxels(d))),
+        _ => Err(PyValueError::new_err(format!(
+            "error_units: expected 'world' or 'voxels', got {units:?}"
+        ))),
+    }
+}
+
 /// Checks the numbers every front end takes and builds the runtime's parameters.
 pub fn params(
     level: f64,
@@ -28,6 +47,7 @@ pub fn params(
     origin: [f64; 3],
     mode_name: &str,
     normals: bool,
+    max_error: Option<(f64, String)>,
 ) -> PyResult<Params> {
     if !level.is_finite() {
         return Err(PyValueError::new_err(format!(
@@ -46,6 +66,7 @@ pub fn params(
     }
     Ok(Params {
         mode: mode(mode_name)?,
+        max_error: bound(max_error)?,
         normals,
         spacing,
         origin,
@@ -56,7 +77,7 @@ pub fn params(
 /// Extracts the surface `volume = level` of a contiguous 3-D array (x fastest in memory; see
 /// `convert`). Returns `(vertices, faces, normals or None, stats)`.
 #[pyfunction]
-#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads))]
+#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads, max_error=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn extract<'py>(
     py: Python<'py>,
@@ -67,8 +88,9 @@ pub fn extract<'py>(
     mode: &str,
     normals: bool,
     threads: usize,
+    max_error: Option<(f64, String)>,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
-    let params = params(level, spacing, origin, mode, normals)?;
+    let params = params(level, spacing, origin, mode, normals, max_error)?;
     let dims = convert::dims(volume, "volume")?;
     let mesh =
         with_element!(py, volume, "volume", T => run::<T>(py, volume, dims, &params, threads))?;
@@ -131,6 +153,7 @@ pub fn stats<'py>(
     d.set_item("result", counts(s.vertices, s.triangles)?)?;
     d.set_item("merged", s.merged)?;
     d.set_item("blocked", s.blocked)?;
+    d.set_item("bounded", s.bounded)?;
     let reduction = if s.t13 == 0 {
         0.0
     } else {

@@ -43,7 +43,7 @@ impl SliceStreamer {
         mode: String,
         normals: bool,
     ) -> PyResult<Self> {
-        let params = extract::params(level, spacing, origin, &mode, normals)?;
+        let params = extract::params(level, spacing, origin, &mode, normals, None)?;
         let [nz, ny, nx] = shape;
         let dims = [nx, ny, nz];
         let len = Scratch::len(dims).map_err(errors::runtime)?;

@@ -165,3 +165,13 @@ def test_a_killed_worker_is_retried_and_the_mesh_is_still_exact(cluster, store, 
     got = skelclimb.dask.extract(arr, 12, mode="paper")
     assert os.path.exists(marker), "a worker was killed"
     same(got, skelclimb.extract(v, 12, mode="paper"))
+
+
+def test_dask_with_an_error_bound():
+    v = blobs((30, 29, 28), 5)
+    arr = da.from_array(v, chunks=(9, 10, 11))
+    with dask.config.set(scheduler="threads"):
+        got = skelclimb.dask.extract(arr, 12, max_error=0.2, error_units="voxels")
+    want = skelclimb.extract(v, 12, max_error=0.2, error_units="voxels")
+    assert want.stats["bounded"] > 0
+    same(got, want)

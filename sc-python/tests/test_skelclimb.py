@@ -405,3 +405,29 @@ def test_values_are_the_larger_sample_of_each_vertex_edge(order):
     a, b = vol[tuple(lower.T)], vol[tuple((lower + step).T)]
     assert np.array_equal(values, np.maximum(a, b))
     assert ((np.minimum(a, b) < 0.5) & (np.maximum(a, b) >= 0.5)).all()
+
+
+def test_max_error_bounds_the_merges():
+    z, y, x = np.mgrid[-1:1:40j, -1:1:40j, -1:1:40j]
+    f = (0.7 - np.sqrt(x * x + 2 * y * y + z * z) + 0.05 * np.sin(9 * x)).astype(np.float32)
+    free = skelclimb.extract(f, 0.0)
+    zero = skelclimb.extract(f, 0.0, max_error=0)
+    assert zero.stats["merged"] == 0
+    assert zero.stats["bounded"] == free.stats["merged"]
+    assert len(zero.faces) == zero.stats["steps123"]["triangles"]
+    last = len(zero.faces)
+    for b in (0.02, 0.05, 0.1, 0.25):
+        m = skelclimb.extract(f, 0.0, max_error=b, error_units="voxels")
+        assert len(m.faces) <= last
+        assert m.stats["merged"] + m.stats["bounded"] == free.stats["merged"]
+        last = len(m.faces)
+    assert last < len(zero.faces)
+    # World units scale with spacing: 0.1 at spacing 2 is 0.05 voxel.
+    world = skelclimb.extract(f, 0.0, max_error=0.1, spacing=(2, 2, 2))
+    voxel = skelclimb.extract(f, 0.0, max_error=0.05, error_units="voxels")
+    assert np.array_equal(world.faces, voxel.faces)
+    for bad, err in ((-1, ValueError), (float("nan"), ValueError), ("x", TypeError)):
+        with pytest.raises(err, match="max_error"):
+            skelclimb.extract(f, 0.0, max_error=bad)
+    with pytest.raises(ValueError, match="error_units"):
+        skelclimb.extract(f, 0.0, max_error=0.1, error_units="mm")

@@ -21,7 +21,7 @@ mod scalar;
 pub mod tables;
 
 pub use error::Error;
-pub use params::{Mode, Params, Volume};
+pub use params::{ErrorBound, Mode, Params, Volume};
 pub use scalar::Scalar;
 mod stats;
 pub use stats::Stats;

@@ -12,6 +12,16 @@ pub enum Mode {
     Steps123,
 }
 
+/// How far Step 4 may move the surface: a grey edge merges only if its vertex lies closer than
+/// this to the two triangles that replace its four, so the bound holds at every removed vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ErrorBound {
+    /// In world units (positions are `index × spacing + origin`).
+    World(f64),
+    /// In grid steps: distances measured on sample indices, whatever the spacing.
+    Voxels(f64),
+}
+
 /// Everything about an extraction besides the samples.
 #[derive(Clone, Copy, Debug)]
 pub struct Params {
@@ -25,6 +35,9 @@ pub struct Params {
     pub spacing: [f64; 3],
     /// World position of sample `(0, 0, 0)`.
     pub origin: [f64; 3],
+    /// The bound on Step 4's displacement of the surface; `None` (the default) merges whatever
+    /// the mode allows, and a bound of zero merges nothing.
+    pub max_error: Option<ErrorBound>,
     /// The case tables; [`crate::tables::DEFAULT`] unless a crate brings its own.
     pub tables: &'static crate::tables::CaseTables,
 }
@@ -38,6 +51,7 @@ impl Params {
             normals: true,
             spacing: [1.0; 3],
             origin: [0.0; 3],
+            max_error: None,
             tables: &crate::tables::DEFAULT,
         }
     }

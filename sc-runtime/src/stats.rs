@@ -7,8 +7,11 @@ pub struct Stats {
     pub t13: u64,
     /// Grey edges merged by Step 4.
     pub merged: u64,
-    /// Occupied interior grey edges that Step 4 left alone (embedded mode's blocking rules).
+    /// Occupied interior grey edges that Step 4 left alone (embedded mode's blocking rules, or
+    /// the error bound).
     pub blocked: u64,
+    /// Of those, the ones only the error bound ([`crate::Params::max_error`]) kept.
+    pub bounded: u64,
     /// Vertices in the output.
     pub vertices: u64,
     /// Triangles in the output.
@@ -25,6 +28,7 @@ impl core::ops::Add for Stats {
             t13: self.t13 + b.t13,
             merged: self.merged + b.merged,
             blocked: self.blocked + b.blocked,
+            bounded: self.bounded + b.bounded,
             vertices: self.vertices + b.vertices,
             triangles: self.triangles + b.triangles,
         }

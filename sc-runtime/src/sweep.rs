@@ -13,7 +13,9 @@
 
 use crate::scratch::{Scratch, WORD_PLANES};
 use crate::tables::{Entry, NO_EAR, grey_edge};
-use crate::vertex::{Field, crossing};
+use crate::vertex::{Field, edge_crossing};
+
+mod bound;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
 
 /// Vertex id of a grey edge merged away by Step 4.
@@ -384,16 +386,25 @@ impl Out<'_> {
         field: &Field<'_, T>,
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
-        let decision = if grey {
+        let mut decision = if grey {
             grid.decide(p, axis)
         } else {
             Decision::Keep
         };
+        let mut bounded = false;
+        if decision == Decision::Merge
+            && let Some(bound) = params.max_error
+            && !grid.within_bound(p, axis, bound, field, params)
+        {
+            decision = Decision::Blocked;
+            bounded = true;
+        }
         let counted = self.emit && grid.owns_edge(p);
         if counted {
             self.stats.v13 += 1;
             self.stats.merged += u64::from(decision == Decision::Merge);
             self.stats.blocked += u64::from(decision == Decision::Blocked);
+            self.stats.bounded += u64::from(bounded);
         }
         if decision == Decision::Merge {
             return Ok(MERGED);
@@ -405,14 +416,7 @@ impl Out<'_> {
         self.next_id += 1;
         if self.emit {
             self.stats.vertices += u64::from(counted);
-            let mut q = p;
-            q[axis] += 1;
-            let (a, b) = (field.value(p), field.value(q));
-            let t = if a.is_nan() || b.is_nan() {
-                0.5
-            } else {
-                crossing(a, b, params.iso)
-            };
+            let t = edge_crossing(field, p, axis, params.iso);
             let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
             let pos: [f32; 3] = core::array::from_fn(|d| {
                 let c = global[d] as f64 + if d == axis { t } else { 0.0 };
@@ -538,15 +542,13 @@ impl Grid<'_> {
         self.cases[(k % 3) * nx * ny + j * nx + i]
     }
 
-    /// Step 4's decision for the occupied grey edge from `p` along `axis` (SPEC §5).
-    fn decide(&self, p: [usize; 3], axis: usize) -> Decision {
-        if self.mode == Mode::Steps123 {
-            return Decision::Keep;
-        }
+    /// The four cubes around the edge from `p` along `axis`, as `(i, j, k)`, if it is interior:
+    /// the lower two then the upper two along the third axis, each pair ordered along the
+    /// remaining one.
+    fn cubes_around(&self, p: [usize; 3], axis: usize) -> Option<[(usize, usize, usize); 4]> {
         let [l, m, n] = p;
         let [nx, ny, nz] = self.dims;
-        // The four cubes around the edge, as (i, j, k); the edge must be interior.
-        let cubes = match axis {
+        Some(match axis {
             0 if (1..ny - 1).contains(&m) && (1..nz - 1).contains(&n) => {
                 [(l, m - 1, n - 1), (l, m, n - 1), (l, m - 1, n), (l, m, n)]
             }
@@ -556,14 +558,29 @@ impl Grid<'_> {
             2 if (1..nx - 1).contains(&l) && (1..ny - 1).contains(&m) => {
                 [(l - 1, m - 1, n), (l, m - 1, n), (l - 1, m, n), (l, m, n)]
             }
-            _ => return Decision::Keep,
+            _ => return None,
+        })
+    }
+
+    /// The parity class of a cube of these samples, which follows its global indices.
+    fn class_of(&self, (i, j, k): (usize, usize, usize)) -> usize {
+        let [ox, oy, oz] = self.offset;
+        ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2
+    }
+
+    /// Step 4's decision for the occupied grey edge from `p` along `axis` (SPEC §5).
+    fn decide(&self, p: [usize; 3], axis: usize) -> Decision {
+        if self.mode == Mode::Steps123 {
+            return Decision::Keep;
+        }
+        let Some(cubes) = self.cubes_around(p, axis) else {
+            return Decision::Keep;
         };
         if self.mode == Mode::Paper {
             return Decision::Merge;
         }
-        let [ox, oy, oz] = self.offset;
         let mergeable = cubes.iter().all(|&(i, j, k)| {
-            let class = ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
+            let class = self.class_of((i, j, k));
             self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis & 1 == 1
         });
         if mergeable && !self.pinch(p, axis) {
@@ -634,7 +651,7 @@ impl Grid<'_> {
         edge_at: &[usize; 12],
     ) -> [u32; 3] {
         let [ox, oy, oz] = self.offset;
-        let along_y = axis == 0 || (axis == 2 && (k + oz) % 2 == 0);
+        let along_y = axis == 0 || (axis == 2 && (k + oz).is_multiple_of(2));
         let (pi, pj) = if along_y { (i, j + 1) } else { (i + 1, j) };
         let nx = self.dims[0];
         let pclass = ((pi + ox) & 1) | ((pj + oy) & 1) << 1 | ((k + oz) & 1) << 2;

@@ -17,6 +17,24 @@ pub(crate) fn crossing(a: f64, b: f64, iso: f64) -> f64 {
     }
 }
 
+/// Where along the edge from `p` along `axis` the surface crosses; the middle at a NaN end.
+#[inline]
+pub(crate) fn edge_crossing<T: Scalar>(
+    field: &Field<'_, T>,
+    p: [usize; 3],
+    axis: usize,
+    iso: f64,
+) -> f64 {
+    let mut q = p;
+    q[axis] += 1;
+    let (a, b) = (field.value(p), field.value(q));
+    if a.is_nan() || b.is_nan() {
+        0.5
+    } else {
+        crossing(a, b, iso)
+    }
+}
+
 /// Reads samples and gradients around grid points of the slices a sweep step can see.
 pub(crate) struct Field<'v, T> {
     pub dims: [usize; 3],

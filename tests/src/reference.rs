@@ -15,6 +15,8 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::sync::OnceLock;
 
 use sc_tablegen::cube::{edge_axis, edge_corners};
+
+use crate::geometry::point_triangle_distance;
 use sc_tablegen::{Entry, Grey, TableSet};
 
 /// A grid edge: its lower end `(x, y, z)` and its axis (0 = x, 1 = y, 2 = z).
@@ -145,14 +147,28 @@ impl Field {
         self.filled([key[0], key[1], key[2]]) != self.filled(Self::upper(key))
     }
 
-    /// SPEC §1's vertex: `t = (iso − a) / (b − a)` clamped to `[1/1024, 1 − 1/1024]`, `1/2` at a NaN
-    /// end; world position `index × spacing + origin`, rounded once to `f32`.
-    pub fn position(&self, key: Key) -> [f32; 3] {
+    /// A vertex's position before rounding to `f32`: world units, or sample indices when
+    /// `voxels` is set.
+    pub fn exact_position(&self, key: Key, voxels: bool) -> [f64; 3] {
+        let t = self.crossing(key);
+        std::array::from_fn(|d| {
+            let c = key[d] as f64 + if d == key[3] { t } else { 0.0 };
+            if voxels {
+                c
+            } else {
+                self.origin[d] + c * self.spacing[d]
+            }
+        })
+    }
+
+    /// SPEC §1's crossing along an edge: `t = (iso − a) / (b − a)` clamped to
+    /// `[1/1024, 1 − 1/1024]`, `1/2` at a NaN end.
+    fn crossing(&self, key: Key) -> f64 {
         let (a, b) = (
             self.value([key[0], key[1], key[2]]),
             self.value(Self::upper(key)),
         );
-        let t = if a.is_nan() || b.is_nan() {
+        if a.is_nan() || b.is_nan() {
             0.5
         } else {
             let t = (self.iso - a) / (b - a);
@@ -161,11 +177,13 @@ impl Field {
             } else {
                 0.5
             }
-        };
-        std::array::from_fn(|d| {
-            let c = key[d] as f64 + if d == key[3] { t } else { 0.0 };
-            (self.origin[d] + c * self.spacing[d]) as f32
-        })
+        }
+    }
+
+    /// SPEC §1's vertex: `t = (iso − a) / (b − a)` clamped to `[1/1024, 1 − 1/1024]`, `1/2` at a NaN
+    /// end; world position `index × spacing + origin`, rounded once to `f32`.
+    pub fn position(&self, key: Key) -> [f32; 3] {
+        self.exact_position(key, false).map(|c| c as f32)
     }
 
     /// All occupied grid edges, in key order. A grid with fewer than 2 samples along an axis has
@@ -332,6 +350,8 @@ pub struct RefMesh {
     pub merged: u64,
     /// Occupied interior grey edges left alone by the rules.
     pub blocked: u64,
+    /// Of those, the ones only the error bound left alone.
+    pub bounded: u64,
     /// The merged grey edges themselves.
     pub merged_keys: BTreeSet<Key>,
 }
@@ -358,6 +378,13 @@ impl RefMesh {
 
 /// Runs Steps 1–4 on `field` in `mode`.
 pub fn extract(field: &Field, mode: RefMode) -> RefMesh {
+    extract_bounded(field, mode, None)
+}
+
+/// Runs Steps 1–4 with an error bound: a grey edge merges only if its vertex lies closer than
+/// `bound` to the two triangles replacing its ears, measured on world positions, or on index
+/// positions when `voxels` is set.
+pub fn extract_bounded(field: &Field, mode: RefMode, bound: Option<(f64, bool)>) -> RefMesh {
     let (merging, rules) = match mode {
         RefMode::Steps123 => (false, Rules::EMBEDDED),
         RefMode::Merge(r) => (true, r),
@@ -408,14 +435,11 @@ pub fn extract(field: &Field, mode: RefMode) -> RefMesh {
             out.blocked += 1;
             continue;
         }
-        out.merged += 1;
-        out.merged_keys.insert(key);
         // The ears: in each cube, the only triangle touching the grey vertex.
         let mut ring: HashMap<Key, Key> = HashMap::new();
+        let mut ears = vec![];
         for c in cubes {
-            let tris = per_cube
-                .get_mut(&c)
-                .expect("a cube around an occupied edge has triangles");
+            let tris = &per_cube[&c];
             let touching: Vec<usize> = (0..tris.len())
                 .filter(|&i| tris[i].is_some_and(|t| t.contains(&key)))
                 .collect();
@@ -424,7 +448,8 @@ pub fn extract(field: &Field, mode: RefMode) -> RefMesh {
                 1,
                 "grey edge {key:?} has no single ear in cube {c:?}"
             );
-            let t = tris[touching[0]].take().expect("present");
+            ears.push((c, touching[0]));
+            let t = tris[touching[0]].expect("present");
             let r = t.iter().position(|&k| k == key).expect("contains");
             let (a, b) = (t[(r + 1) % 3], t[(r + 2) % 3]);
             assert!(
@@ -468,8 +493,25 @@ pub fn extract(field: &Field, mode: RefMode) -> RefMesh {
         );
         let s = on[0];
         let q = |i: usize| quad[(s + i) % 4];
-        extra.push([q(0), q(1), q(2)]);
-        extra.push([q(0), q(2), q(3)]);
+        let replacing = [[q(0), q(1), q(2)], [q(0), q(2), q(3)]];
+        if let Some((limit, voxels)) = bound {
+            let at = |k: Key| field.exact_position(k, voxels);
+            let g = at(key);
+            let close = replacing
+                .iter()
+                .all(|t| point_triangle_distance(g, t.map(at)) < limit);
+            if !close {
+                out.blocked += 1;
+                out.bounded += 1;
+                continue;
+            }
+        }
+        out.merged += 1;
+        out.merged_keys.insert(key);
+        for (c, i) in ears {
+            per_cube.get_mut(&c).expect("cube")[i] = None;
+        }
+        extra.extend(replacing);
     }
 
     for cube in order {

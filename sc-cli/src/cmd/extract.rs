@@ -86,6 +86,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         normals: !args.no_normals,
         threads: args.threads,
         coordinates: args.space,
+        max_error: args.error_bound(),
     };
     let world = surface::world(&grid, &request);
     let mesh = surface::extract(&grid, &request, &progress)?;
@@ -103,9 +104,11 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         _ if !is_paper_knot => None,
         ModeArg::Paper => Some(mesh.stats.triangles),
         _ => {
+            // Table 1's figure, without any --max-error.
             let request = Request {
                 mode: Mode::Paper,
                 normals: false,
+                max_error: None,
                 ..request
             };
             Some(
@@ -139,6 +142,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         dtype: grid.samples.dtype().name(),
         iso,
         mode: args.mode.into(),
+        max_error: args.error_bound(),
         stats: mesh.stats,
         read: read_time,
         extract: extract_time,

@@ -49,8 +49,8 @@ class Mesh:
     normals : (V, 3) float32 array or None
         Unit normals pointing out of that region, if asked for.
     stats : dict
-        ``steps123`` and ``result`` (vertex and triangle counts), ``merged`` and ``blocked``
-        grey edges, ``reduction_percent``, ``mode``, ``iso``, ``dims`` (``[nx, ny, nz]``).
+        ``steps123`` and ``result`` (vertex and triangle counts), ``merged``, ``blocked`` and
+        ``bounded`` grey edges (``bounded``: blocked by ``max_error`` alone), ``reduction_percent``, ``mode``, ``iso``, ``dims`` (``[nx, ny, nz]``).
     """
 
     __slots__ = ("vertices", "faces", "normals", "stats")
@@ -138,6 +138,21 @@ def _level(level):
     return level
 
 
+def _bound(max_error, error_units):
+    """``(max_error, error_units)`` for the native calls, or None without a bound."""
+    if max_error is None:
+        return None
+    try:
+        max_error = float(max_error)
+    except (TypeError, ValueError):
+        raise TypeError(f"max_error: expected a number or None, got {max_error!r}") from None
+    if not (np.isfinite(max_error) and max_error >= 0):
+        raise ValueError(f"max_error: must be a finite number, 0 or more, got {max_error}")
+    if error_units not in ("world", "voxels"):
+        raise ValueError(f"error_units: expected 'world' or 'voxels', got {error_units!r}")
+    return (max_error, error_units)
+
+
 def _pad(volume, level):
     """``volume`` with one layer around it that is empty at ``level``, so every surface closes."""
     if np.issubdtype(volume.dtype, np.integer):
@@ -164,6 +179,8 @@ def extract(
     pad=False,
     normals=True,
     threads=0,
+    max_error=None,
+    error_units="world",
 ):
     """Meshes the surface ``volume == level``; samples ``>= level`` are inside.
 
@@ -191,6 +208,13 @@ def extract(
     threads : int
         Worker threads, 0 for all cores. The mesh is identical for any number. The GIL is
         released while the mesh is built.
+    max_error : float or None
+        A bound on how far merging moves the surface: a grey edge merges only if the vertex it
+        removes lies closer than this to the two triangles that replace its four. ``0`` merges
+        nothing (Steps 1–3's triangles); ``None`` merges what ``mode`` allows.
+        ``stats["bounded"]`` counts the merges the bound refused.
+    error_units : ``"world"`` (default) or ``"voxels"``
+        ``max_error`` in world units (index × spacing) or in grid steps.
 
     Returns
     -------
@@ -218,7 +242,8 @@ def extract(
         volume = np.asarray(volume, order=order)
         origin = tuple(o - s for o, s in zip(origin, spacing))
     verts, faces, norms, stats = _native.extract(
-        volume, level, spacing, origin, mode, bool(normals), threads
+        volume, level, spacing, origin, mode, bool(normals), threads,
+        _bound(max_error, error_units),
     )
     return Mesh(verts, faces, norms, stats)
 

@@ -34,6 +34,8 @@ def extract(
     pad: bool = ...,
     normals: bool = ...,
     threads: int = ...,
+    max_error: Optional[float] = ...,
+    error_units: Literal["world", "voxels"] = ...,
 ) -> Mesh: ...
 def marching_cubes(
     volume: npt.NDArray[Any],
@@ -101,4 +103,6 @@ def extract_block(
     origin: _Triple = ...,
     mode: _Mode = ...,
     normals: bool = ...,
+    max_error: Optional[float] = ...,
+    error_units: Literal["world", "voxels"] = ...,
 ) -> BlockMesh: ...

@@ -79,7 +79,7 @@ class BlockMesh:
 
 
 def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=(0, 0, 0),
-                  mode="embedded", normals=True):
+                  mode="embedded", normals=True, max_error=None, error_units="world"):
     """Meshes the cubes ``cubes`` of a grid of ``grid`` samples from the samples around them.
 
     ``samples`` is a 3-D array laid out as for :func:`skelclimb.extract` (C order
@@ -99,7 +99,7 @@ def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=
     >>> bool((joined.vertices == whole.vertices).all() and (joined.faces == whole.faces).all())
     True
     """
-    from . import _level, _triple, _volume, _MODES
+    from . import _MODES, _bound, _level, _triple, _volume
 
     samples = _volume(samples, "samples")
     level = _level(level)
@@ -112,6 +112,6 @@ def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=
         raise ValueError("at, grid and cubes: expected three entries each (x, y, z)")
     share = _native.extract_block(
         samples, at, grid, cubes, level, _triple(spacing, "spacing"), _triple(origin, "origin"),
-        mode, bool(normals),
+        mode, bool(normals), _bound(max_error, error_units),
     )
     return BlockMesh(share, mode, level, bool(normals))

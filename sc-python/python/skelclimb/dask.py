@@ -24,9 +24,8 @@ from ._blocks import block_samples, extract_block
 __all__ = ["extract"]
 
 
-def _mesh(samples, at, grid, cubes, level, spacing, origin, mode, normals):
-    return extract_block(np.asarray(samples), level, at=at, grid=grid, cubes=cubes,
-                         spacing=spacing, origin=origin, mode=mode, normals=normals)
+def _mesh(samples, at, grid, cubes, options):
+    return extract_block(np.asarray(samples), at=at, grid=grid, cubes=cubes, **options)
 
 
 def _merge(*shares):
@@ -47,7 +46,7 @@ def _cube_ranges(chunks, n):
 
 
 def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded",
-            normals=True, split_every=8, compute=True):
+            normals=True, max_error=None, error_units="world", split_every=8, compute=True):
     """Meshes the surface ``array == level`` of a 3-D ``dask.array``, block by block.
 
     Parameters
@@ -56,7 +55,7 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         Axes ``(z, y, x)`` as for a C-ordered array in :func:`skelclimb.extract` (so
         ``dask.array.from_zarr`` of a ZYX store works as it is). One task per chunk; chunks of
         64³–256³ samples balance task overhead against memory per task.
-    level, spacing, origin, mode, normals
+    level, spacing, origin, mode, normals, max_error, error_units
         As for :func:`skelclimb.extract`; spacing and origin are ``(x, y, z)``.
     split_every : int
         How many shares each merge task joins (the fan-in of the reduction tree).
@@ -72,7 +71,7 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     """
     import dask
 
-    from . import _MODES, _level, _triple
+    from . import _MODES, _bound, _level, _triple
 
     level = _level(level)
     spacing, origin = _triple(spacing, "spacing"), _triple(origin, "origin")
@@ -86,6 +85,9 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     grid = (nx, ny, nz)
     if min(grid) < 2:
         raise ValueError(f"array: every axis needs at least 2 samples, got shape {array.shape}")
+    _bound(max_error, error_units)
+    options = dict(level=level, spacing=spacing, origin=origin, mode=mode, normals=normals,
+                   max_error=max_error, error_units=error_units)
     zc, yc, xc = array.chunks
     mesh = dask.delayed(_mesh, pure=True)
     shares = []
@@ -95,7 +97,7 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
                 cubes = (cx, cy, cz)
                 (x0, x1), (y0, y1), (z0, z1) = block_samples(grid, cubes)
                 shares.append(mesh(array[z0:z1, y0:y1, x0:x1], (x0, y0, z0), grid, cubes,
-                                   level, spacing, origin, mode, normals))
+                                   options))
     merge = dask.delayed(_merge, pure=True)
     while len(shares) > 1:
         shares = [merge(*shares[i:i + split_every])

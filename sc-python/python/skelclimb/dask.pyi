@@ -10,6 +10,8 @@ def extract(
     origin: _Triple = ...,
     mode: _Mode = ...,
     normals: bool = ...,
+    max_error: float | None = ...,
+    error_units: str = ...,
     split_every: int = ...,
     compute: bool = ...,
 ) -> Mesh | Any: ...

@@ -1,0 +1,132 @@
+//! The error bound on Step 4 (`Params::max_error`): one more local blocking rule.
+//!
+//! A merge removes a grey edge's vertex and replaces the fan of four ears around it by two
+//! triangles; each is the three distinct outer vertices of a pair of ears (see
+//! `Grid::merged_triangle`). The rule measures how far the removed vertex lies from those two
+//! triangles, from the same samples the other rules read, so blocks, threads and streaming all
+//! decide alike. Blocking a merge changes nothing but that grey edge's own four ears: every other
+//! merge keeps its ears and its triangles, so no decision depends on another.
+
+use super::Grid;
+use crate::tables::Entry;
+use crate::vertex::{Field, edge_crossing};
+use crate::{ErrorBound, Params, Scalar};
+
+impl Grid<'_> {
+    /// Whether the merge of the occupied interior grey edge from `p` along `axis` moves the
+    /// surface by less than `bound`.
+    pub(super) fn within_bound<T: Scalar>(
+        &self,
+        p: [usize; 3],
+        axis: usize,
+        bound: ErrorBound,
+        field: &Field<'_, T>,
+        params: &Params,
+    ) -> bool {
+        let (limit, world) = match bound {
+            ErrorBound::World(d) => (d, true),
+            ErrorBound::Voxels(d) => (d, false),
+        };
+        // Zero, negative or NaN: nothing is close enough.
+        if limit.is_nan() || limit <= 0.0 {
+            return false;
+        }
+        let Some(cubes) = self.cubes_around(p, axis) else {
+            return true;
+        };
+        let point = |q: [usize; 3], a: usize| -> [f64; 3] {
+            let t = edge_crossing(field, q, a, params.iso);
+            core::array::from_fn(|d| {
+                let c = (q[d] + self.offset[d]) as f64 + if d == a { t } else { 0.0 };
+                if world {
+                    params.origin[d] + c * params.spacing[d]
+                } else {
+                    c
+                }
+            })
+        };
+        // The outer edges of each cube's ear around this grey edge.
+        let outer = cubes.map(|(i, j, k)| {
+            let class = self.class_of((i, j, k));
+            let entry: &Entry = &self.entries[class * 256 + usize::from(self.case_at(i, j, k))];
+            let [b, _, f] = entry.tris[usize::from(entry.ears[axis])];
+            [b, f].map(|e| cube_edge([i, j, k], e))
+        });
+        // Pairs share a face: along y for x-greys and even-layer z-greys, else along x.
+        let n = p[2] + self.offset[2];
+        let pairs = if axis == 2 && n.is_multiple_of(2) {
+            [(0, 2), (1, 3)]
+        } else {
+            [(0, 1), (2, 3)]
+        };
+        let g = point(p, axis);
+        pairs.iter().all(|&(a, b)| {
+            let mut corners: [([usize; 3], usize); 4] =
+                [outer[a][0], outer[a][1], outer[b][0], outer[b][1]];
+            corners.sort_unstable();
+            // The pair's two ears share one outer edge: drop the repeat.
+            let distinct = if corners[0] == corners[1] {
+                [corners[1], corners[2], corners[3]]
+            } else if corners[1] == corners[2] {
+                [corners[0], corners[2], corners[3]]
+            } else {
+                [corners[0], corners[1], corners[3]]
+            };
+            let tri = distinct.map(|(q, a)| point(q, a));
+            distance_squared(g, tri) < limit * limit
+        })
+    }
+}
+
+/// The lower end and axis of cube-local edge `e` of cube `(i, j, k)` (SPEC §2 numbering: edge
+/// `4 · axis + r`, with `r`'s bits the offsets along the other two axes in order).
+fn cube_edge(cube: [usize; 3], e: u8) -> ([usize; 3], usize) {
+    let axis = usize::from(e / 4);
+    let (a, b) = (usize::from(e & 1), usize::from(e >> 1 & 1));
+    let offset = match axis {
+        0 => [0, a, b],
+        1 => [a, 0, b],
+        _ => [a, b, 0],
+    };
+    (core::array::from_fn(|d| cube[d] + offset[d]), axis)
+}
+
+/// Squared distance from `p` to the triangle `t` (closest point by Voronoi regions, Ericson's
+/// "Real-Time Collision Detection" §5.1.5).
+fn distance_squared(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
+    let sub = |u: [f64; 3], v: [f64; 3]| [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
+    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let along =
+        |o: [f64; 3], d: [f64; 3], s: f64| [o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]];
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    let closest = if d1 <= 0.0 && d2 <= 0.0 {
+        a
+    } else {
+        let bp = sub(p, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        let cp = sub(p, c);
+        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        let vc = d1 * d4 - d3 * d2;
+        let vb = d5 * d2 - d1 * d6;
+        let va = d3 * d6 - d5 * d4;
+        if d3 >= 0.0 && d4 <= d3 {
+            b
+        } else if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            along(a, ab, d1 / (d1 - d3))
+        } else if d6 >= 0.0 && d5 <= d6 {
+            c
+        } else if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            along(a, ac, d2 / (d2 - d6))
+        } else if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)))
+        } else {
+            let denom = 1.0 / (va + vb + vc);
+            let (v, w) = (vb * denom, vc * denom);
+            let q = along(a, ab, v);
+            along(q, ac, w)
+        }
+    };
+    let d = sub(p, closest);
+    dot(d, d)
+}
