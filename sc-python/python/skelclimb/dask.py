@@ -1,6 +1,6 @@
 """Meshing a ``dask.array`` one task per block, on whatever Dask scheduler is active.
 
-Each task reads its chunk plus a thin halo (one sample before, two after), meshes it with
+Each task reads its chunk plus a thin halo (one sample before, three after), meshes it with
 :func:`skelclimb.extract_block`, and returns a compact share keyed by global grid edges; a tree
 of merges joins the shares into exactly the mesh :func:`skelclimb.extract` makes of the whole
 array, whatever the chunking, the scheduler (threads, processes, a ``distributed`` cluster) or
@@ -19,9 +19,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._blocks import block_samples, extract_block
+from ._blocks import extract_block
 
 __all__ = ["extract"]
+
+# Samples past a chunk's far side that its cubes read (see skelclimb.block_samples).
+_AFTER = 3
 
 
 def _mesh(samples, at, grid, cubes, options):
@@ -42,7 +45,19 @@ def _cube_ranges(chunks, n):
     for size in chunks:
         out.append((start, min(start + size, n - 1)))
         start += size
-    return [r for r in out if r[0] < r[1]]
+    return out
+
+
+def _at_least(chunks, m):
+    """``chunks`` with any chunk smaller than ``m`` joined to its neighbour, so that a halo of
+    ``m`` samples comes from one neighbour only."""
+    out = []
+    for c in chunks:
+        if out and (out[-1] < m or c < m):
+            out[-1] += c
+        else:
+            out.append(c)
+    return tuple(out)
 
 
 def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded",
@@ -70,6 +85,7 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         whole array.
     """
     import dask
+    import dask.array as da
 
     from . import _MODES, _bound, _level, _triple
 
@@ -88,16 +104,23 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     _bound(max_error, error_units)
     options = dict(level=level, spacing=spacing, origin=origin, mode=mode, normals=normals,
                    max_error=max_error, error_units=error_units)
+    # Each task gets its chunk plus the halo extract_block reads (one sample before, up to
+    # three after), cut from its neighbours by Dask's overlap: every chunk is read once, and
+    # only the thin halo slabs travel between workers.
+    array = array.rechunk(tuple(_at_least(c, _AFTER) for c in array.chunks))
+    halo = da.overlap.overlap(array, depth={a: (1, _AFTER) for a in range(3)}, boundary="none")
+    parts = halo.to_delayed()
     zc, yc, xc = array.chunks
     mesh = dask.delayed(_mesh, pure=True)
     shares = []
-    for cz in _cube_ranges(zc, nz):
-        for cy in _cube_ranges(yc, ny):
-            for cx in _cube_ranges(xc, nx):
+    for iz, cz in enumerate(_cube_ranges(zc, nz)):
+        for iy, cy in enumerate(_cube_ranges(yc, ny)):
+            for ix, cx in enumerate(_cube_ranges(xc, nx)):
+                if cz[0] == cz[1] or cy[0] == cy[1] or cx[0] == cx[1]:
+                    continue
                 cubes = (cx, cy, cz)
-                (x0, x1), (y0, y1), (z0, z1) = block_samples(grid, cubes)
-                shares.append(mesh(array[z0:z1, y0:y1, x0:x1], (x0, y0, z0), grid, cubes,
-                                   options))
+                at = tuple(max(c[0] - 1, 0) for c in cubes)
+                shares.append(mesh(parts[iz, iy, ix], at, grid, cubes, options))
     merge = dask.delayed(_merge, pure=True)
     while len(shares) > 1:
         shares = [merge(*shares[i:i + split_every])
