@@ -136,8 +136,13 @@ pub struct ExtractArgs {
     #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
     /// Surround the volume with one layer of empty samples, so that every surface is closed.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "stream")]
     pub pad: bool,
+    /// Read the volume a few slices at a time instead of whole, so that a volume larger than
+    /// memory can be meshed (raw files and NIfTI; one thread). This happens by itself when the
+    /// samples would fill more than half the machine's memory.
+    #[arg(long, conflicts_with = "demo")]
+    pub stream: bool,
     /// Where the samples are.
     #[command(flatten)]
     pub placement: Placement,

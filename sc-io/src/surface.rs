@@ -1,12 +1,13 @@
 //! The bridge from a typed [`Grid`] to the generic extractor.
 
-use sc_runtime::{ErrorBound, Mesh, Mode, Params, Volume, extract_par};
+use sc_runtime::{ErrorBound, Mesh, Mode, Params, Scratch, SliceStreamer, Volume, extract_par};
 
 use crate::error::Result;
 use crate::progress::Progress;
+use crate::read::stream::Stream;
 use crate::space::{Coordinates, World};
 use crate::volume::{Grid, Range, Sample};
-use crate::with_samples;
+use crate::{with_dtype, with_samples};
 
 /// What to extract.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +40,20 @@ impl Request {
     }
 }
 
+/// The runtime's parameters for `request` on `grid`: the iso value in stored units, and the
+/// origin when the world map is a translation (otherwise the mesh is placed afterwards).
+fn params(grid: &Grid, request: &Request, world: &World) -> Params {
+    let mut params = Params::new(grid.scale.invert(request.iso));
+    params.mode = request.mode;
+    params.normals = request.normals;
+    params.spacing = grid.spacing;
+    params.max_error = request.max_error;
+    if world.is_translation() {
+        params.origin = world.offset;
+    }
+    params
+}
+
 /// The map from sample positions to the coordinates `request` asks for.
 pub fn world(grid: &Grid, request: &Request) -> World {
     World::new(grid.frame, grid.origin, request.coordinates)
@@ -48,20 +63,64 @@ pub fn world(grid: &Grid, request: &Request) -> World {
 /// volume in one (see [`crate::space`]), otherwise index × spacing + origin.
 pub fn extract(grid: &Grid, request: &Request, progress: &dyn Progress) -> Result<Mesh> {
     let world = world(grid, request);
-    let mut params = Params::new(grid.scale.invert(request.iso));
-    params.mode = request.mode;
-    params.normals = request.normals;
-    params.spacing = grid.spacing;
-    params.max_error = request.max_error;
-    if world.is_translation() {
-        params.origin = world.offset;
-    }
+    let params = params(grid, request, &world);
     progress.phase("meshing", grid.dims[2].saturating_sub(1) as u64);
     let mut mesh =
         with_samples!(&grid.samples, v => run(v, grid.dims, &params, request.threads, progress))?;
     if !world.is_translation() {
         world.place(&mut mesh);
     }
+    Ok(mesh)
+}
+
+/// Extracts the surface of a volume read slab by slab: the same mesh as [`extract`] of the
+/// whole volume, holding a few slices instead of all of them, on one thread.
+pub fn extract_stream(
+    stream: &mut Stream,
+    request: &Request,
+    progress: &dyn Progress,
+) -> Result<Mesh> {
+    let grid = &stream.grid;
+    let world = world(grid, request);
+    let params = params(grid, request, &world);
+    progress.phase("meshing", grid.dims[2] as u64);
+    let mut mesh =
+        with_dtype!(grid.samples.dtype(), T => stream_typed::<T>(stream, &params, progress))?;
+    if !world.is_translation() {
+        world.place(&mut mesh);
+    }
+    Ok(mesh)
+}
+
+/// Bytes of samples per slab read: large enough for fast reads, small beside any volume that
+/// needs streaming.
+const SLAB_BYTES: usize = 16 << 20;
+
+fn stream_typed<T: Sample>(
+    stream: &mut Stream,
+    params: &Params,
+    progress: &dyn Progress,
+) -> Result<Mesh> {
+    let dims = stream.grid.dims;
+    let nxy = dims[0] * dims[1];
+    let len = Scratch::len(dims)?;
+    let (mut bytes, mut words) = (vec![0u8; len.bytes], vec![0u32; len.words]);
+    let mut ring = vec![T::zeroed(); SliceStreamer::<T, Mesh>::ring_len(dims)];
+    let scratch = Scratch::new(&mut bytes, &mut words, dims)?;
+    let mut streamer = SliceStreamer::new(dims, params, scratch, &mut ring, Mesh::default())?;
+    let per_slab = (SLAB_BYTES / (nxy * size_of::<T>()).max(1)).max(1);
+    let mut done = 0;
+    while done < dims[2] {
+        let slab = stream.read::<T>(per_slab)?;
+        for slice in slab.chunks_exact(nxy) {
+            streamer.push(slice)?;
+        }
+        let n = slab.len() / nxy;
+        done += n;
+        progress.inc(n as u64);
+    }
+    let (mut mesh, stats) = streamer.finish()?;
+    mesh.stats = stats;
     Ok(mesh)
 }
 

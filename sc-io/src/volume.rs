@@ -202,6 +202,11 @@ impl Samples {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+
+    /// No samples, of type `dtype`: a grid whose samples are read later, or slice by slice.
+    pub fn empty(dtype: Dtype) -> Samples {
+        crate::with_dtype!(dtype, T => T::wrap(Vec::new()))
+    }
 }
 
 fn dtype_of<T: Sample>(_: &[T]) -> Dtype {

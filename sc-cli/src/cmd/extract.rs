@@ -15,9 +15,23 @@ use crate::summary::Summary;
 use sc_io::atomic::AtomicFile;
 use sc_io::error::{Error, Result};
 use sc_io::progress::Progress;
-use sc_io::read::{self, Format};
+use sc_io::read::{self, Format, ReadOptions, stream};
 use sc_io::surface::{self, Request};
 use sc_io::write::{MeshFormat, WriteOptions};
+
+/// Whether the samples of `path` would take more than half the machine's memory, so that reading
+/// them slice by slice is the only sane way. Unknown sizes and memory (not Linux) say no.
+fn too_big(path: &Path, options: &ReadOptions) -> bool {
+    let Ok(Some(s)) = stream::open(path, options) else {
+        return false;
+    };
+    let bytes = s.grid.dims.iter().product::<usize>() as u64 * s.grid.samples.dtype().size() as u64;
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let kib = m.lines().find(|l| l.starts_with("MemTotal:"))?;
+        kib.split_whitespace().nth(1)?.parse::<u64>().ok()
+    });
+    total.is_some_and(|kib| bytes > kib * 1024 / 2)
+}
 
 /// Reads, extracts, writes and reports. Output files are opened first, so that a bad output
 /// path fails before a long read, and written whole or not at all.
@@ -56,9 +70,25 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
 
     let clock = Instant::now();
+    let mut stream = match &args.input {
+        Some(path) if args.stream || (!args.pad && too_big(path, &options)) => {
+            stream::open(path, &options)?
+        }
+        _ => None,
+    };
+    if let (true, None, Some(path)) = (args.stream, &stream, &args.input) {
+        return Err(Error::Usage(format!(
+            "{}: --stream reads raw files and NIfTI (.nii, .nii.gz) slice by slice; this file \
+             is read whole",
+            path.display()
+        )));
+    }
     let (mut grid, iso, input) = match (&args.input, args.demo) {
         (Some(path), _) => (
-            read::read(path, &options, &progress)?,
+            match &stream {
+                Some(s) => s.grid.clone(),
+                None => read::read(path, &options, &progress)?,
+            },
             args.iso.unwrap_or_default(),
             path.display().to_string(),
         ),
@@ -89,12 +119,21 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         max_error: args.error_bound(),
     };
     let world = surface::world(&grid, &request);
-    let mesh = surface::extract(&grid, &request, &progress)?;
+    let mesh = match &mut stream {
+        Some(s) => {
+            s.grid.spacing = grid.spacing;
+            s.grid.origin = grid.origin;
+            surface::extract_stream(s, &request, &progress)?
+        }
+        None => surface::extract(&grid, &request, &progress)?,
+    };
     let extract_time = clock.elapsed();
     // The value range is only needed to explain an empty mesh, so the pass over every sample
-    // is made only then.
+    // is made only then (and not at all over a volume that was streamed).
     if mesh.triangles.is_empty() {
-        let why = surface::why_empty(&grid.range(), iso)
+        let why = (stream.is_none())
+            .then(|| surface::why_empty(&grid.range(), iso))
+            .flatten()
             .unwrap_or_else(|| "no sample is on both sides of the iso value".into());
         warn(format!("{input}: {why}; writing an empty mesh"));
     }

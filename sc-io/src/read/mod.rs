@@ -11,6 +11,7 @@ pub mod nrrd;
 pub mod payload;
 pub mod raw;
 pub mod sidecar;
+pub mod stream;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom};
@@ -160,7 +161,7 @@ pub fn read(path: &Path, options: &ReadOptions, progress: &dyn Progress) -> Resu
 /// Refuses what would mesh into garbage: an empty volume, and spacing or origin that are not
 /// finite, not positive, or beyond what `f32` vertices can hold (NaN or infinite vertices make
 /// invalid glTF; zero spacing collapses the mesh to a plane).
-fn check_placement(path: &Path, grid: &Grid) -> Result<()> {
+pub(crate) fn check_placement(path: &Path, grid: &Grid) -> Result<()> {
     let [nx, ny, nz] = grid.dims;
     if grid.dims.contains(&0) {
         return Err(Error::file(
@@ -245,6 +246,24 @@ const MAX_TRAILING: u64 = 1 << 20;
 
 /// Reads a sample block, with errors that name the data file and say what is missing.
 pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples> {
+    let mut decoded = open_block(block)?;
+    let verified = block.encoding == Encoding::Raw && block.skip_lines == 0;
+    let result =
+        payload::read_samples(&mut decoded, block.layout, verified, progress).and_then(|samples| {
+            if block.encoding != Encoding::Raw {
+                // Reading on to the end of the stream is what makes the decoder check the
+                // gzip CRC and length (zlib: Adler-32): a flipped byte is an error, not a
+                // silently altered sample. What follows the samples is bounded, not trusted.
+                io::copy(&mut (&mut decoded).take(MAX_TRAILING), &mut io::sink())?;
+            }
+            Ok(samples)
+        });
+    result.map_err(|e| block_error(block, e))
+}
+
+/// The decoded bytes of a block, positioned at its first sample; a raw file too short for the
+/// block is refused before anything is read.
+pub(crate) fn open_block(block: &Block<'_>) -> Result<Box<dyn Read>> {
     let path = block.path;
     let need = block
         .layout
@@ -286,28 +305,26 @@ pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples>
     let skipped = io::copy(
         &mut (&mut decoded).take(block.skip_decoded),
         &mut io::sink(),
-    );
-    let result = skipped.and_then(|n| {
-        if n < block.skip_decoded {
-            Err(io::Error::new(
+    )
+    .map_err(|e| block_error(block, e))?;
+    if skipped < block.skip_decoded {
+        return Err(block_error(
+            block,
+            io::Error::new(
                 io::ErrorKind::UnexpectedEof,
                 "the data ends before the samples start",
-            ))
-        } else {
-            let verified = block.encoding == Encoding::Raw && block.skip_lines == 0;
-            let samples = payload::read_samples(&mut decoded, block.layout, verified, progress)?;
-            if block.encoding != Encoding::Raw {
-                // Reading on to the end of the stream is what makes the decoder check the
-                // gzip CRC and length (zlib: Adler-32): a flipped byte is an error, not a
-                // silently altered sample. What follows the samples is bounded, not trusted.
-                io::copy(&mut (&mut decoded).take(MAX_TRAILING), &mut io::sink())?;
-            }
-            Ok(samples)
-        }
-    });
-    result.map_err(|e| match (block.encoding, e.kind()) {
+            ),
+        ));
+    }
+    Ok(decoded)
+}
+
+/// A block's read error in words: which file, and whether it is short or corrupt.
+pub(crate) fn block_error(block: &Block<'_>, e: io::Error) -> Error {
+    let path = block.path;
+    match (block.encoding, e.kind()) {
         (Encoding::Raw, _) | (_, io::ErrorKind::UnexpectedEof) => Error::io(path, e),
         (Encoding::Gzip, _) => Error::file(path, format!("corrupt gzip data: {e}")),
         (Encoding::Zlib, _) => Error::file(path, format!("corrupt zlib data: {e}")),
-    })
+    }
 }

@@ -13,12 +13,24 @@ use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::space::{Frame, Space};
-use crate::volume::{Dtype, Endian, Grid};
+use crate::volume::{Dtype, Endian, Grid, Samples};
 
 /// Reads a NIfTI-1 volume. The placement comes from the sform when its code is set, else from
 /// the qform, as the NIfTI standard orders them (spacing from pixdim with the qform);
 /// scl_slope/scl_inter map stored values to real ones.
 pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
+    let (mut grid, block, rescale) = open(path)?;
+    grid.samples = read_block(&block, progress)?;
+    if let Some((slope, inter)) = rescale {
+        grid.rescale(slope, inter);
+    }
+    Ok(grid)
+}
+
+/// The header: the grid without its samples, the sample block, and the value map to apply once
+/// the samples are read (`scl_slope`, `scl_inter`), if any.
+#[allow(clippy::type_complexity)]
+pub fn open(path: &Path) -> Result<(Grid, Block<'_>, Option<(f64, f64)>)> {
     let gz = path.to_string_lossy().to_ascii_lowercase().ends_with(".gz");
     let encoding = if gz { Encoding::Gzip } else { Encoding::Raw };
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
@@ -72,15 +84,13 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
         skip_decoded,
         layout,
     };
-    let mut grid = Grid::new(read_block(&block, progress)?, dims, "NIfTI-1");
+    let mut grid = Grid::new(Samples::empty(dtype), dims, "NIfTI-1");
 
     // Spacing that is not a positive finite number is refused after reading (`check_placement`),
     // naming pixdim, rather than replaced by a guess.
     grid.spacing = [1, 2, 3].map(|i| f64::from(header.pixdim[i]).abs());
     let slope = f64::from(header.scl_slope);
-    if slope != 0.0 && slope.is_finite() {
-        grid.rescale(slope, f64::from(header.scl_inter));
-    }
+    let rescale = (slope != 0.0 && slope.is_finite()).then(|| (slope, f64::from(header.scl_inter)));
     if header.sform_code > 0 {
         let rows = [header.srow_x, header.srow_y, header.srow_z].map(|r| r.map(f64::from));
         let columns = [0, 1, 2].map(|a| [rows[0][a], rows[1][a], rows[2][a]]);
@@ -112,7 +122,7 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
             header.qform_code
         ));
     }
-    Ok(grid)
+    Ok((grid, block, rescale))
 }
 
 /// The first three dimensions; any further ones (time, components) must be 1.

@@ -69,7 +69,7 @@ pub fn read_samples(
 /// Chunk size for progress updates: large enough that the bar costs nothing.
 const CHUNK: usize = 1 << 22;
 
-fn read_typed<T: Sample>(
+pub(crate) fn read_typed<T: Sample>(
     mut reader: impl Read,
     layout: Layout,
     verified: bool,

@@ -11,6 +11,12 @@ use crate::volume::Grid;
 /// Reads `path` as `layout` says. The file size must match exactly: a raw file has nothing else
 /// to catch wrong `--dims` or `--dtype`, and a size mismatch is almost always one.
 pub fn read(path: &Path, layout: &RawLayout, progress: &dyn Progress) -> Result<Grid> {
+    let block = block(path, layout)?;
+    Ok(Grid::new(read_block(&block, progress)?, layout.dims, "raw"))
+}
+
+/// The sample block of `path` laid out as `layout` says, checked against the file's size.
+pub fn block<'a>(path: &'a Path, layout: &RawLayout) -> Result<Block<'a>> {
     let [nx, ny, nz] = layout.dims;
     let count = nx
         .checked_mul(ny)
@@ -37,13 +43,12 @@ pub fn read(path: &Path, layout: &RawLayout, progress: &dyn Progress) -> Result<
             ),
         ));
     }
-    let block = Block {
+    Ok(Block {
         path,
         start: Start::At(layout.header_bytes),
         skip_lines: 0,
         encoding: Encoding::Raw,
         skip_decoded: 0,
         layout: block_layout,
-    };
-    Ok(Grid::new(read_block(&block, progress)?, layout.dims, "raw"))
+    })
 }

@@ -1,0 +1,144 @@
+//! `--stream`: raw files (with options or a sidecar) and NIfTI (plain and gzip) read a few
+//! slices at a time give byte for byte the mesh and counts of a whole read, in every mode; a
+//! truncated file fails cleanly; formats that cannot stream say so.
+
+mod common;
+use common::{entries, fixture, gzip, nifti};
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use predicates::str::contains;
+
+fn skelclimb() -> Command {
+    Command::cargo_bin("skelclimb").unwrap()
+}
+
+/// Runs `extract` on `input` with `args`, with and without `--stream`, and checks that the mesh
+/// bytes and the counts agree.
+fn same_either_way(dir: &Path, input: &str, args: &[&str]) {
+    for mode in ["embedded", "paper", "steps123"] {
+        let mut outputs = vec![];
+        for stream in [false, true] {
+            let out = format!("{mode}-{stream}.ply");
+            let stats = format!("{mode}-{stream}.json");
+            let mut cmd = skelclimb();
+            cmd.current_dir(dir)
+                .args(["extract", input, "-q", "--mode", mode, "-o", &out])
+                .args(["--stats-json", &stats])
+                .args(args);
+            if stream {
+                cmd.arg("--stream");
+            }
+            cmd.assert().success();
+            let mut json: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(dir.join(&stats)).unwrap()).unwrap();
+            json["seconds"] = serde_json::Value::Null;
+            outputs.push((std::fs::read(dir.join(&out)).unwrap(), json));
+        }
+        assert!(
+            outputs[0].1["result"]["triangles"].as_u64().unwrap() > 1000,
+            "{input}"
+        );
+        assert_eq!(outputs[0].1, outputs[1].1, "{input} {mode}: counts");
+        assert!(
+            outputs[0].0 == outputs[1].0,
+            "{input} {mode}: mesh bytes differ"
+        );
+    }
+}
+
+#[test]
+fn streamed_volumes_mesh_exactly_as_whole_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::copy(fixture("brainsmall-crop-40x40x30.u8.raw"), d.join("b.raw")).unwrap();
+    same_either_way(
+        d,
+        "b.raw",
+        &["--dims", "40,40,30", "--dtype", "u8", "--iso", "20"],
+    );
+    // i16 big-endian behind a 100-byte header, with spacing and origin.
+    let stent = std::fs::read(fixture("stent-crop-40x40x30.i16.raw")).unwrap();
+    let mut be = vec![7u8; 100];
+    be.extend(stent.chunks_exact(2).flat_map(|c| [c[1], c[0]]));
+    std::fs::write(d.join("s.raw"), &be).unwrap();
+    same_either_way(
+        d,
+        "s.raw",
+        &[
+            "--dims",
+            "40,40,30",
+            "--dtype",
+            "i16",
+            "--endian",
+            "big",
+            "--header-bytes",
+            "100",
+            "--iso",
+            "281",
+            "--spacing",
+            "0.7,0.7,1.25",
+            "--origin",
+            "-5,3,10",
+        ],
+    );
+    // f32 through a JSON sidecar.
+    let f32s: Vec<u8> = stent
+        .chunks_exact(2)
+        .flat_map(|c| (f32::from(i16::from_le_bytes([c[0], c[1]])) * 0.5).to_le_bytes())
+        .collect();
+    std::fs::write(d.join("f.raw"), &f32s).unwrap();
+    std::fs::write(
+        d.join("f.json"),
+        r#"{"dims": [40, 40, 30], "dtype": "f32", "spacing": [1, 1, 2]}"#,
+    )
+    .unwrap();
+    same_either_way(d, "f.raw", &["--iso", "140.25"]);
+    // NIfTI: gzip and plain, placed in RAS by its header.
+    std::fs::copy(fixture("itk-t1-mri.nii.gz"), d.join("t1.nii.gz")).unwrap();
+    same_either_way(d, "t1.nii.gz", &["--iso", "20.5"]);
+    std::fs::write(d.join("t1.nii"), nifti()).unwrap();
+    same_either_way(d, "t1.nii", &["--iso", "20.5", "--space", "lps"]);
+}
+
+#[test]
+fn streaming_failures_are_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A NIfTI cut short inside its samples, and a gzip one with a corrupt tail.
+    let nii = nifti();
+    std::fs::write(d.join("short.nii"), &nii[..nii.len() - 5000]).unwrap();
+    let mut gz = gzip(&nii);
+    let n = gz.len();
+    gz[n - 6] ^= 0xFF; // the CRC
+    std::fs::write(d.join("crc.nii.gz"), &gz).unwrap();
+    for (input, message) in [("short.nii", "short.nii"), ("crc.nii.gz", "crc.nii.gz")] {
+        let before = entries(d);
+        skelclimb()
+            .current_dir(d)
+            .args(["extract", input, "--iso", "20.5", "--stream", "-o", "m.ply"])
+            .assert()
+            .code(1)
+            .stderr(contains(message));
+        assert_eq!(entries(d), before, "{input} left files behind");
+    }
+    // Formats read whole say so; --pad needs the whole volume.
+    std::fs::copy(fixture("stent-ct.npz"), d.join("s.npz")).unwrap();
+    skelclimb()
+        .current_dir(d)
+        .args([
+            "extract", "s.npz", "--iso", "281", "--stream", "-o", "m.ply",
+        ])
+        .assert()
+        .code(2)
+        .stderr(contains("read whole"));
+    skelclimb()
+        .current_dir(d)
+        .args([
+            "extract", "s.npz", "--iso", "281", "--stream", "--pad", "-o", "m.ply",
+        ])
+        .assert()
+        .code(2);
+    assert!(!d.join("m.ply").exists());
+}
