@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Peak resident memory of `skelclimb extract` on large volumes written here: a 256³ f32 and a
-# 512³ u16 sphere (64 MiB and 256 MiB of samples). Needs python3 with numpy, and GNU time.
+# 512³ u16 sphere (64 MiB and 256 MiB of samples) read whole, and a 1600 × 1600 × 1000 u8 ball
+# (2.4 GiB) read slice by slice with --stream. Needs python3 with numpy, GNU time, and 2.5 GB of
+# free space in $TMPDIR.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=$(mktemp -d)
@@ -16,6 +18,17 @@ for n, dtype, scale in ((256, np.float32, 1.0), (512, np.uint16, 1000.0)):
         r = np.sqrt(x * x + y * y + c[z] * c[z])
         out[z] = ((0.8 - r) * scale if dtype == np.float32 else np.clip((1.6 - r) * scale, 0, 65535)).astype(dtype)
     out.flush()
+# 2.4 GiB of u8: a ball of radius 0.6 (in [-1, 1]) centred in a 1600 × 1600 × 1000 box.
+nx, nz = 1600, 1000
+out = np.memmap(f"{d}/ball.raw", dtype=np.uint8, mode="w+", shape=(nz, nx, nx))
+c = (np.arange(nx) + 0.5) * (2.0 / nx) - 1.0
+y, x = np.meshgrid(c, c, indexing="ij")
+r2 = (x * x + y * y).astype(np.float32)
+for z in range(nz):
+    cz = (z + 0.5) * (2.0 / nz) - 1.0
+    out[z] = np.clip(128 + 200 * (0.6 - np.sqrt(r2 + cz * cz)), 0, 255).astype(np.uint8)
+out.flush()
+del out
 PY
 cargo build --quiet --release -p sc-cli
 for spec in "256 f32 0 4" "512 u16 800 2"; do
@@ -26,3 +39,6 @@ for spec in "256 f32 0 4" "512 u16 800 2"; do
       --threads "$threads" -q -o "$dir/out.ply"
   done
 done
+/usr/bin/time -f "ball 1600×1600×1000 u8 (--stream): peak RSS %M KiB, input $(( 1600 * 1600 * 1000 / 1024 )) KiB, %e s" \
+  ./target/release/skelclimb extract "$dir/ball.raw" --dims 1600,1600,1000 --dtype u8 --iso 128 \
+  --stream --no-normals -q -o "$dir/out.ply"

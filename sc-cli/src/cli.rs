@@ -71,6 +71,9 @@ pub struct InputArgs {
     /// interpolation) instead of refusing it.
     #[arg(long, help_heading = "DICOM input")]
     pub resample_gaps: bool,
+    /// OME-Zarr input: the multiscale level to read, 0 being the finest.
+    #[arg(long, default_value_t = 0)]
+    pub zarr_level: usize,
 }
 
 impl InputArgs {
@@ -92,6 +95,7 @@ impl InputArgs {
                 series: self.series.clone(),
                 resample_gaps: self.resample_gaps,
             },
+            zarr_level: self.zarr_level,
         }
     }
 }
@@ -99,8 +103,8 @@ impl InputArgs {
 /// Arguments of `extract`.
 #[derive(Debug, Args)]
 pub struct ExtractArgs {
-    /// The volume: a .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd, .npy/.npz file, a DICOM directory, or a
-    /// raw file with --dims and --dtype.
+    /// The volume: a .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd, .npy/.npz file, a Zarr or OME-Zarr
+    /// store, a DICOM directory, or a raw file with --dims and --dtype.
     #[arg(required_unless_present = "demo", conflicts_with = "demo")]
     pub input: Option<PathBuf>,
     /// Use a built-in volume instead of a file; `knot` is the paper's knotted torus.
@@ -139,8 +143,8 @@ pub struct ExtractArgs {
     #[arg(long, conflicts_with = "stream")]
     pub pad: bool,
     /// Read the volume a few slices at a time instead of whole, so that a volume larger than
-    /// memory can be meshed (raw files and NIfTI; one thread). This happens by itself when the
-    /// samples would fill more than half the machine's memory.
+    /// memory can be meshed (raw files, NIfTI and Zarr; one thread). This happens by itself for
+    /// Zarr stores, and when the samples would fill more than half the machine's memory.
     #[arg(long, conflicts_with = "demo")]
     pub stream: bool,
     /// Where the samples are.

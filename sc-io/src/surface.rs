@@ -92,10 +92,6 @@ pub fn extract_stream(
     Ok(mesh)
 }
 
-/// Bytes of samples per slab read: large enough for fast reads, small beside any volume that
-/// needs streaming.
-const SLAB_BYTES: usize = 16 << 20;
-
 fn stream_typed<T: Sample>(
     stream: &mut Stream,
     params: &Params,
@@ -108,7 +104,7 @@ fn stream_typed<T: Sample>(
     let mut ring = vec![T::zeroed(); SliceStreamer::<T, Mesh>::ring_len(dims)];
     let scratch = Scratch::new(&mut bytes, &mut words, dims)?;
     let mut streamer = SliceStreamer::new(dims, params, scratch, &mut ring, Mesh::default())?;
-    let per_slab = (SLAB_BYTES / (nxy * size_of::<T>()).max(1)).max(1);
+    let per_slab = stream.slab();
     let mut done = 0;
     while done < dims[2] {
         let slab = stream.read::<T>(per_slab)?;

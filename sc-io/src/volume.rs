@@ -214,7 +214,7 @@ fn dtype_of<T: Sample>(_: &[T]) -> Dtype {
 }
 
 /// What the readers and the padding need of a sample type beyond what the extractor needs.
-pub trait Sample: Scalar + Pod + PartialOrd {
+pub trait Sample: Scalar + Pod + PartialOrd + zarrs::array::ElementOwned {
     /// The matching [`Dtype`].
     const DTYPE: Dtype;
     /// Wraps a typed vector.

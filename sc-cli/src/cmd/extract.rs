@@ -71,15 +71,20 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
 
     let clock = Instant::now();
     let mut stream = match &args.input {
-        Some(path) if args.stream || (!args.pad && too_big(path, &options)) => {
+        Some(path)
+            if args.stream
+                || (!args.pad
+                    && (Format::detect(path, &options)? == Format::Zarr
+                        || too_big(path, &options))) =>
+        {
             stream::open(path, &options)?
         }
         _ => None,
     };
     if let (true, None, Some(path)) = (args.stream, &stream, &args.input) {
         return Err(Error::Usage(format!(
-            "{}: --stream reads raw files and NIfTI (.nii, .nii.gz) slice by slice; this file \
-             is read whole",
+            "{}: --stream reads raw files, NIfTI (.nii, .nii.gz) and Zarr slice by slice; this \
+             file is read whole",
             path.display()
         )));
     }

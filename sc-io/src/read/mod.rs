@@ -12,6 +12,7 @@ pub mod payload;
 pub mod raw;
 pub mod sidecar;
 pub mod stream;
+pub mod zarr;
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom};
@@ -44,6 +45,8 @@ pub struct ReadOptions {
     pub array: Option<String>,
     /// Series choice and gap handling for a DICOM directory.
     pub dicom: dicom::DicomOptions,
+    /// The level of an OME-Zarr multiscale image (0, the finest, by default).
+    pub zarr_level: usize,
 }
 
 /// The input formats, told apart by extension (a directory is a DICOM series).
@@ -65,6 +68,8 @@ pub enum Format {
     Dicom,
     /// Raw samples described by a JSON sidecar (see [`sidecar`]).
     Sidecar,
+    /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
+    Zarr,
 }
 
 impl Format {
@@ -75,7 +80,9 @@ impl Format {
             .map(|n| n.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         let ends = |suffixes: &[&str]| suffixes.iter().any(|s| name.ends_with(s));
-        let format = if path.is_dir() {
+        let format = if zarr::is_store(path) {
+            Format::Zarr
+        } else if path.is_dir() {
             Format::Dicom
         } else if ends(&[".nii", ".nii.gz"]) {
             Format::Nifti
@@ -115,6 +122,11 @@ impl Format {
                 "--series and --resample-gaps apply to DICOM directories".into(),
             ));
         }
+        if options.zarr_level != 0 && format != Format::Zarr {
+            return Err(Error::Usage(
+                "--zarr-level picks a level of an OME-Zarr image".into(),
+            ));
+        }
         if options.array.is_some() && format != Format::Npz {
             return Err(Error::Usage(
                 "--array selects an array in an .npz file".into(),
@@ -133,6 +145,7 @@ impl Format {
             Format::Npy => "NumPy .npy",
             Format::Npz => "NumPy .npz",
             Format::Dicom => "DICOM series",
+            Format::Zarr => "Zarr",
             Format::Sidecar => "raw + JSON sidecar",
         }
     }
@@ -152,6 +165,10 @@ pub fn read(path: &Path, options: &ReadOptions, progress: &dyn Progress) -> Resu
         Format::Npy | Format::Npz => npy::read(path, options.array.as_deref(), progress),
         Format::Dicom => dicom::read(path, &options.dicom, progress),
         Format::Sidecar => read_with_sidecar(path, progress),
+        Format::Zarr => match stream::open(path, options)? {
+            Some(s) => s.read_all(progress),
+            None => unreachable!("a Zarr store always streams"),
+        },
     }?;
     grid.format = format.name();
     check_placement(path, &grid)?;

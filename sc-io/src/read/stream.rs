@@ -1,15 +1,15 @@
 //! Volumes read a few z-slices at a time, for meshing volumes larger than memory: raw files
-//! (with `--dims` or a JSON sidecar) and NIfTI-1 (`.nii`, and `.nii.gz` decompressed as it is
-//! read). The header is parsed by the format's own reader, so placement and value maps are the
+//! (with `--dims` or a JSON sidecar), NIfTI-1 (`.nii`, and `.nii.gz` decompressed as it is
+//! read) and Zarr arrays (a row of chunks at a time). The header is parsed by the format's own reader, so placement and value maps are the
 //! same as a whole read's.
 
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 use super::payload::{self, Encoding, Layout};
-use super::{Block, Format, ReadOptions, block_error, nifti, open_block, raw, sidecar};
+use super::{Block, Format, ReadOptions, block_error, nifti, open_block, raw, sidecar, zarr};
 use crate::error::{Error, Result};
-use crate::progress::Silent;
+use crate::progress::{Progress, Silent};
 use crate::volume::{Grid, Sample, Samples};
 
 /// A volume whose samples are read slab by slab. `grid` has the placement, the type and the
@@ -17,12 +17,22 @@ use crate::volume::{Grid, Sample, Samples};
 pub struct Stream {
     /// Everything about the volume but its samples.
     pub grid: Grid,
+    /// The file (a sidecar's data file) or store the samples come from, for error messages.
     path: PathBuf,
-    reader: Box<dyn Read>,
-    encoding: Encoding,
-    layout: Layout,
-    /// z-slices read so far; the data file (a sidecar's) for error messages is `path`.
+    source: Source,
+    /// z-slices read so far.
     read: usize,
+}
+
+enum Source {
+    /// A sample block in a file, decoded as it is read.
+    Block {
+        reader: Box<dyn Read>,
+        encoding: Encoding,
+        layout: Layout,
+    },
+    /// A Zarr array, read by rows of chunks.
+    Zarr(Box<zarr::Source>),
 }
 
 /// Opens `path` for reading slab by slab, or `Ok(None)` if its format cannot stream (only whole
@@ -57,52 +67,107 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
             }
             (grid, block)
         }
+        Format::Zarr => {
+            let (grid, source) = zarr::open(path, options.zarr_level)?;
+            super::check_placement(path, &grid)?;
+            return Ok(Some(Stream {
+                grid,
+                path: path.to_path_buf(),
+                source: Source::Zarr(Box::new(source)),
+                read: 0,
+            }));
+        }
         _ => return Ok(None),
     };
     grid.format = format.name();
     super::check_placement(path, &grid)?;
     Ok(Some(Stream {
-        reader: open_block(&block)?,
+        source: Source::Block {
+            reader: open_block(&block)?,
+            encoding: block.encoding,
+            layout: block.layout,
+        },
         path: block.path.to_path_buf(),
-        encoding: block.encoding,
-        layout: block.layout,
         grid,
         read: 0,
     }))
 }
 
+/// Bytes of samples per slab read from a file: large enough for fast reads, small beside any
+/// volume that needs streaming.
+const SLAB_BYTES: usize = 16 << 20;
+
 impl Stream {
+    /// z-slices per read that suit the source: a row of chunks for Zarr, about 16 MiB for files.
+    pub fn slab(&self) -> usize {
+        match &self.source {
+            Source::Zarr(z) => z.chunk_z.max(1),
+            Source::Block { layout, .. } => {
+                let [nx, ny, _] = self.grid.dims;
+                (SLAB_BYTES / (nx * ny * layout.dtype.size()).max(1)).max(1)
+            }
+        }
+    }
+
     /// The next `slices` z-slices (fewer at the end), x fastest.
     pub fn read<T: Sample>(&mut self, slices: usize) -> Result<Vec<T>> {
         let [nx, ny, nz] = self.grid.dims;
         let slices = slices.min(nz - self.read);
-        let layout = Layout {
-            count: nx * ny * slices,
-            ..self.layout
+        let (z0, z1) = (self.read, self.read + slices);
+        let samples = match &mut self.source {
+            Source::Zarr(z) => z.read::<T>(&self.path, z0, z1)?,
+            Source::Block {
+                reader,
+                encoding,
+                layout,
+            } => {
+                let slab = Layout {
+                    count: nx * ny * slices,
+                    ..*layout
+                };
+                let error =
+                    |e: io::Error| block_error(&block_at(&self.path, *encoding, *layout), e);
+                let samples =
+                    payload::read_typed::<T>(&mut *reader, slab, false, &Silent).map_err(error)?;
+                if z1 == nz && *encoding != Encoding::Raw {
+                    // As a whole read does: read on to make the decoder check the gzip CRC.
+                    io::copy(&mut reader.take(super::MAX_TRAILING), &mut io::sink())
+                        .map_err(error)?;
+                }
+                samples
+            }
         };
-        let samples = payload::read_typed::<T>(&mut self.reader, layout, false, &Silent)
-            .map_err(|e| self.error(e))?;
-        self.read += slices;
-        if self.read == nz && self.encoding != Encoding::Raw {
-            // As a whole read does: read on to make the decoder check the gzip CRC.
-            io::copy(
-                &mut (&mut self.reader).take(super::MAX_TRAILING),
-                &mut io::sink(),
-            )
-            .map_err(|e| self.error(e))?;
-        }
+        self.read = z1;
         Ok(samples)
     }
 
-    fn error(&self, e: io::Error) -> Error {
-        let block = Block {
-            path: &self.path,
-            start: super::Start::At(0),
-            skip_lines: 0,
-            encoding: self.encoding,
-            skip_decoded: 0,
-            layout: self.layout,
-        };
-        block_error(&block, e)
+    /// Every sample, for a whole read.
+    pub fn read_all(mut self, progress: &dyn Progress) -> Result<Grid> {
+        let dtype = self.grid.samples.dtype();
+        progress.phase("reading", self.grid.dims[2] as u64);
+        let samples = crate::with_dtype!(dtype, T => {
+            let mut all: Vec<T> = Vec::new();
+            while self.read < self.grid.dims[2] {
+                let slab = self.slab();
+                let before = self.read;
+                all.extend(self.read::<T>(slab)?);
+                progress.inc((self.read - before) as u64);
+            }
+            T::wrap(all)
+        });
+        self.grid.samples = samples;
+        Ok(self.grid)
+    }
+}
+
+/// A block description for error messages about a streamed block.
+fn block_at(path: &Path, encoding: Encoding, layout: Layout) -> Block<'_> {
+    Block {
+        path,
+        start: super::Start::At(0),
+        skip_lines: 0,
+        encoding,
+        skip_decoded: 0,
+        layout,
     }
 }
