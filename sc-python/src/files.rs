@@ -89,7 +89,7 @@ fn triples<T: numpy::Element + Copy>(
 /// of shape `(nz, ny, nx)`, spacing and origin as `(x, y, z)`. A rescale slope/intercept in the
 /// file is applied (to float32 for 8- and 16-bit samples, float64 otherwise).
 #[pyfunction]
-#[pyo3(signature = (path, *, dims=None, dtype=None, endian="little", header_bytes=0, array=None, series=None, resample_gaps=false))]
+#[pyo3(signature = (path, *, dims=None, dtype=None, endian="little", header_bytes=0, array=None, series=None, resample_gaps=false, zarr_level=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn load<'py>(
     py: Python<'py>,
@@ -101,6 +101,7 @@ pub fn load<'py>(
     array: Option<String>,
     series: Option<String>,
     resample_gaps: bool,
+    zarr_level: usize,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let raw = match (dims, dtype) {
         (Some(dims), Some(dtype)) => Some(RawLayout {
@@ -131,6 +132,7 @@ pub fn load<'py>(
             series,
             resample_gaps,
         },
+        zarr_level,
     };
     let grid = py
         .detach(|| sc_io::read::read(&path, &options, &Silent))

@@ -254,9 +254,10 @@ def load(path, **options):
     NIfTI (``.nii``, ``.nii.gz``), NRRD (``.nrrd``, ``.nhdr``), MetaImage (``.mha``, ``.mhd``),
     NumPy (``.npy``, ``.npz``; ``array=`` picks an array), a DICOM series (a directory, searched
     recursively; ``series=`` picks one by UID or number, ``resample_gaps=True`` resamples a
-    series with missing slices), raw
-    samples with ``dims=(nx, ny, nz), dtype="i16"`` (and ``endian=``, ``header_bytes=``), or raw
-    samples with a JSON sidecar.
+    series with missing slices), a Zarr v2/v3 array or OME-Zarr image (``zarr_level=`` picks a
+    multiscale level), raw samples with ``dims=(nx, ny, nz), dtype="i16"`` (and ``endian=``,
+    ``header_bytes=``), or raw samples with a JSON sidecar. For Zarr stores larger than memory,
+    use :func:`skelclimb.dask.extract`.
 
     Returns ``(volume, spacing, origin)``: a C-ordered array of shape ``(nz, ny, nx)``, and spacing
     and origin as ``(x, y, z)``, ready for :func:`extract`. A rescale slope and intercept in the
