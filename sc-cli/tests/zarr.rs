@@ -130,7 +130,7 @@ fn ome_zarr_levels_are_placed_by_their_transforms() {
             .build(store.clone(), path)
             .unwrap();
         array.store_metadata().unwrap();
-        let all = ArraySubset::new_with_ranges(&shape.map(|n| 0..n as u64));
+        let all = ArraySubset::new_with_ranges(&shape.map(|n| 0..n));
         array.store_array_subset_elements(&all, samples).unwrap();
     }
     let to_raw = |name: &str, v: &[i16]| {
