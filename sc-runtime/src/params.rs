@@ -13,7 +13,8 @@ pub enum Mode {
 }
 
 /// How far Step 4 may move the surface: a grey edge merges only if its vertex lies closer than
-/// this to the two triangles that replace its four, so the bound holds at every removed vertex.
+/// this to the two triangles that replace its four, and the new diagonal (its quarter points and
+/// middle) closer than this to the four old triangles.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ErrorBound {
     /// In world units (positions are `index × spacing + origin`).

@@ -382,8 +382,9 @@ pub fn extract(field: &Field, mode: RefMode) -> RefMesh {
 }
 
 /// Runs Steps 1–4 with an error bound: a grey edge merges only if its vertex lies closer than
-/// `bound` to the two triangles replacing its ears, measured on world positions, or on index
-/// positions when `voxels` is set.
+/// `bound` to the two triangles replacing its ears, and the new diagonal's quarter points and
+/// middle closer than `bound` to the ears, measured on world positions, or on index positions
+/// when `voxels` is set.
 pub fn extract_bounded(field: &Field, mode: RefMode, bound: Option<(f64, bool)>) -> RefMesh {
     let (merging, rules) = match mode {
         RefMode::Steps123 => (false, Rules::EMBEDDED),
@@ -497,9 +498,18 @@ pub fn extract_bounded(field: &Field, mode: RefMode, bound: Option<(f64, bool)>)
         if let Some((limit, voxels)) = bound {
             let at = |k: Key| field.exact_position(k, voxels);
             let g = at(key);
-            let close = replacing
-                .iter()
-                .all(|t| point_triangle_distance(g, t.map(at)) < limit);
+            // The removed vertex near the new triangles, and the new diagonal q0–q2 (at its
+            // quarter points and middle) near the old ones.
+            let fan: Vec<[[f64; 3]; 3]> = ring.iter().map(|(&a, &b)| [g, at(a), at(b)]).collect();
+            let (d0, d2) = (at(q(0)), at(q(2)));
+            let diagonal_close = [0.25, 0.5, 0.75].iter().all(|&t| {
+                let m: [f64; 3] = std::array::from_fn(|d| d0[d] + t * (d2[d] - d0[d]));
+                fan.iter().any(|&f| point_triangle_distance(m, f) < limit)
+            });
+            let close = diagonal_close
+                && replacing
+                    .iter()
+                    .all(|t| point_triangle_distance(g, t.map(at)) < limit);
             if !close {
                 out.blocked += 1;
                 out.bounded += 1;

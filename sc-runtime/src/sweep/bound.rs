@@ -2,9 +2,10 @@
 //!
 //! A merge removes a grey edge's vertex and replaces the fan of four ears around it by two
 //! triangles; each is the three distinct outer vertices of a pair of ears (see
-//! `Grid::merged_triangle`). The rule measures how far the removed vertex lies from those two
-//! triangles, from the same samples the other rules read, so blocks, threads and streaming all
-//! decide alike. Blocking a merge changes nothing but that grey edge's own four ears: every other
+//! `Grid::merged_triangle`). The rule measures both ways: the removed vertex must lie within the
+//! bound of the two new triangles, and the new diagonal (at its quarter points and middle) within
+//! the bound of the four old ones. It reads the same samples as the other rules, so blocks,
+//! threads and streaming all decide alike. Blocking a merge changes nothing but that grey edge's own four ears: every other
 //! merge keeps its ears and its triangles, so no decision depends on another.
 
 use super::Grid;
@@ -60,20 +61,41 @@ impl Grid<'_> {
             [(0, 1), (2, 3)]
         };
         let g = point(p, axis);
-        pairs.iter().all(|&(a, b)| {
-            let mut corners: [([usize; 3], usize); 4] =
-                [outer[a][0], outer[a][1], outer[b][0], outer[b][1]];
+        // The two replacing triangles, as edges: each is the three distinct outer edges of a
+        // pair's ears (the two ears share one).
+        let replacing = pairs.map(|(a, b)| {
+            let mut corners = [outer[a][0], outer[a][1], outer[b][0], outer[b][1]];
             corners.sort_unstable();
-            // The pair's two ears share one outer edge: drop the repeat.
-            let distinct = if corners[0] == corners[1] {
+            if corners[0] == corners[1] {
                 [corners[1], corners[2], corners[3]]
             } else if corners[1] == corners[2] {
                 [corners[0], corners[2], corners[3]]
             } else {
                 [corners[0], corners[1], corners[3]]
-            };
-            let tri = distinct.map(|(q, a)| point(q, a));
-            distance_squared(g, tri) < limit * limit
+            }
+        });
+        let limit2 = limit * limit;
+        let new = replacing.map(|t| t.map(|(q, a)| point(q, a)));
+        // One way: the removed vertex is close to the new triangles.
+        if !new.iter().all(|&t| distance_squared(g, t) < limit2) {
+            return false;
+        }
+        // The other way: the new diagonal (the edge both replacing triangles have) stays close to
+        // the four old triangles. Where the quad is twisted, the diagonal runs farthest from
+        // them near its middle, while the removed vertex can sit close to a corner of the new
+        // triangles; the quarter points and the middle catch that.
+        let fan = outer.map(|[b, f]| [point(b.0, b.1), g, point(f.0, f.1)]);
+        let shared: [([usize; 3], usize); 2] = {
+            let mut it = replacing[0].iter().filter(|e| replacing[1].contains(e));
+            match (it.next(), it.next()) {
+                (Some(&u), Some(&v)) => [u, v],
+                _ => return false,
+            }
+        };
+        let [u, v] = shared.map(|(q, a)| point(q, a));
+        [0.25, 0.5, 0.75].iter().all(|&t| {
+            let m: [f64; 3] = core::array::from_fn(|d| u[d] + t * (v[d] - u[d]));
+            fan.iter().any(|&f| distance_squared(m, f) < limit2)
         })
     }
 }
