@@ -124,8 +124,9 @@ pub struct ExtractArgs {
     #[arg(long, value_enum, default_value_t = ModeArg::Embedded)]
     pub mode: ModeArg,
     /// Merge a grey edge only if the vertex it removes lies closer than this to the two
-    /// triangles that replace its four: a bound on how far Step 4 moves the surface, in the
-    /// volume's world units (mm for most scans) or, with `--error-units voxels`, in grid steps.
+    /// triangles that replace its four, and their new diagonal closer than this to the four: a
+    /// bound on how far Step 4 moves the surface, in the volume's world units (mm for most
+    /// scans) or, with `--error-units voxels`, in grid steps.
     /// 0 merges nothing (Steps 1–3's triangles); no bound (the default) merges what the mode
     /// allows.
     #[arg(long, value_parser = parse_max_error)]

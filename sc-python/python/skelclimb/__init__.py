@@ -210,7 +210,8 @@ def extract(
         released while the mesh is built.
     max_error : float or None
         A bound on how far merging moves the surface: a grey edge merges only if the vertex it
-        removes lies closer than this to the two triangles that replace its four. ``0`` merges
+        removes lies closer than this to the two triangles that replace its four, and their new
+        diagonal closer than this to the four. ``0`` merges
         nothing (Steps 1–3's triangles); ``None`` merges what ``mode`` allows.
         ``stats["bounded"]`` counts the merges the bound refused.
     error_units : ``"world"`` (default) or ``"voxels"``
