@@ -43,6 +43,79 @@ pub enum Command {
     /// Rerun the paper's Table 1 comparison: triangles and time for Steps 1–3 and Steps 1–4
     /// (embedded and paper modes) on the built-in volumes and any volumes given.
     Table1(Table1Args),
+    /// Draw a mesh (.ply, .obj, .stl) into a PNG picture, to look at a result without a display.
+    ///
+    /// Examples:
+    ///   skelclimb render knot.ply -o knot.png --wireframe
+    ///   skelclimb render embedded.ply --compare steps123.ply -o both.png --view front
+    ///   skelclimb render bounded.ply --color-by-error steps123.ply -o error.png
+    #[command(verbatim_doc_comment)]
+    Render(RenderArgs),
+}
+
+/// Arguments of `render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The mesh: .ply (text or binary), .obj or .stl.
+    pub mesh: PathBuf,
+    /// The picture to write (.png).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// A named view [default: iso]; z is up.
+    #[arg(long, value_enum, conflicts_with_all = ["azimuth", "elevation"])]
+    pub view: Option<View>,
+    /// Degrees around the z axis (0 looks along +y).
+    #[arg(long, allow_negative_numbers = true)]
+    pub azimuth: Option<f64>,
+    /// Degrees above the horizon (90 looks down).
+    #[arg(long, allow_negative_numbers = true)]
+    pub elevation: Option<f64>,
+    /// Gouraud shading (normals averaged at vertices) instead of flat faces.
+    #[arg(long)]
+    pub smooth: bool,
+    /// Draw the triangles' edges over the surface.
+    #[arg(long)]
+    pub wireframe: bool,
+    /// Picture size per mesh, `WIDTHxHEIGHT`.
+    #[arg(long, default_value = "800x600", value_parser = parse_size_wh)]
+    pub size: [usize; 2],
+    /// A second mesh, drawn beside the first with the same camera; each is labelled with its
+    /// triangle count.
+    #[arg(long, conflicts_with = "color_by_error")]
+    pub compare: Option<PathBuf>,
+    /// Colour each triangle by the distance from its centroid to this mesh (blue 0, red the
+    /// largest); the largest and mean distances are printed.
+    #[arg(long)]
+    pub color_by_error: Option<PathBuf>,
+}
+
+/// `--view` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum View {
+    /// Looking along +y.
+    Front,
+    /// Looking along −x.
+    Side,
+    /// Looking down.
+    Top,
+    /// From above, at an angle.
+    Iso,
+}
+
+fn parse_size_wh(s: &str) -> Result<[usize; 2], String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?} is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (16..=8192).contains(n))
+    };
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok([w, h]),
+        _ => Err("width and height must be whole numbers from 16 to 8192".into()),
+    }
 }
 
 /// How to read a volume file; options for raw files are refused for the other formats.

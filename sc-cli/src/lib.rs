@@ -8,6 +8,7 @@ pub mod cmd;
 pub mod histogram;
 pub mod interrupt;
 pub mod progress;
+pub mod render;
 pub mod summary;
 
 pub use sc_io::{Error, Result};
@@ -18,5 +19,6 @@ pub fn run(cli: &cli::Cli) -> Result<()> {
         cli::Command::Extract(args) => cmd::extract::run(args, cli.quiet),
         cli::Command::Info(args) => cmd::info::run(args, cli.quiet),
         cli::Command::Table1(args) => cmd::table1::run(args, cli.quiet),
+        cli::Command::Render(args) => render::run(args, cli.quiet),
     }
 }

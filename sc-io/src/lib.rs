@@ -16,6 +16,7 @@
 
 pub mod atomic;
 pub mod error;
+pub mod mesh_in;
 pub mod progress;
 pub mod read;
 pub mod space;

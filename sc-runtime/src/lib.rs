@@ -16,6 +16,7 @@ extern crate std;
 extern crate self as sc_runtime;
 
 mod error;
+pub mod geometry;
 mod params;
 mod scalar;
 pub mod tables;
