@@ -27,11 +27,9 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare import BUILTIN, DTYPES  # noqa: E402  (the same generators as the Rust benchmarks)
 
-import mcubes  # noqa: E402
 import skimage  # noqa: E402
 import skimage.measure  # noqa: E402
 import vtk  # noqa: E402
-import zmesh  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
 import skelclimb  # noqa: E402
@@ -42,6 +40,11 @@ DTYPES = dict(DTYPES, f32=np.float32, f64=np.float64, i8=np.int8, u32=np.uint32,
 def volumes(data_dir):
     for name, (make, iso) in BUILTIN.items():
         yield name, make(256).astype(np.float32), iso
+    yield from data_volumes(data_dir)
+
+
+def data_volumes(data_dir):
+    """The raw + JSON volumes of ``data_dir`` at each suggested iso value: (label, array, iso)."""
     if not data_dir:
         print("SC_DATA_DIR not set: the real volumes are skipped", file=sys.stderr)
         return
@@ -76,7 +79,17 @@ def flying_edges(vol, iso):
     return verts, faces
 
 
+# PyMCubes and zmesh are imported where they are called, so that other scripts can import this
+# module's volumes without installing them.
+def pymcubes(vol, iso):
+    import mcubes
+
+    return mcubes.marching_cubes(vol, iso)
+
+
 def zmesh_mask(vol, iso):
+    import zmesh
+
     mesher = zmesh.Mesher((1, 1, 1))
     mesher.mesh((vol >= iso).astype(np.uint8))
     mesh = mesher.get(1, normals=False)
@@ -87,7 +100,7 @@ def zmesh_mask(vol, iso):
 PEERS = {
     "skelclimb": lambda v, iso: skelclimb.marching_cubes(v, iso, threads=1)[:2],
     "scikit-image": lambda v, iso: skimage.measure.marching_cubes(v, iso)[:2],
-    "PyMCubes": lambda v, iso: mcubes.marching_cubes(v, iso),
+    "PyMCubes": pymcubes,
     "zmesh (mask)": zmesh_mask,
     "VTK Flying Edges": flying_edges,
 }

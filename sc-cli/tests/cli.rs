@@ -523,16 +523,7 @@ fn max_error_trades_triangles_for_a_bound() {
     let run = |bound: &[&str]| -> serde_json::Value {
         skelclimb()
             .current_dir(dir.path())
-            .args([
-                "extract",
-                "--iso",
-                "20.5",
-                "-q",
-                "-o",
-                "m.ply",
-                "--stats-json",
-                "s.json",
-            ])
+            .args("extract --iso 20.5 -q -o m.ply --stats-json s.json".split(' '))
             .arg(&input)
             .args(bound)
             .assert()

@@ -179,27 +179,13 @@ fn two_meshes_side_by_side_and_errors_in_colour() {
     assert!(covered(&half(true)) > 5000 && covered(&half(false)) > 5000);
     skelclimb()
         .current_dir(d)
-        .args([
-            "render",
-            "k.ply",
-            "--color-by-error",
-            "k.ply",
-            "-o",
-            "self.png",
-        ])
+        .args("render k.ply --color-by-error k.ply -o self.png".split(' '))
         .assert()
         .success()
         .stderr(contains("max 0.0000, mean 0.0000"));
     skelclimb()
         .current_dir(d)
-        .args([
-            "render",
-            "k.ply",
-            "--color-by-error",
-            "k13.ply",
-            "-o",
-            "e.png",
-        ])
+        .args("render k.ply --color-by-error k13.ply -o e.png".split(' '))
         .assert()
         .success()
         .stderr(contains("max 0.0"));

@@ -108,18 +108,6 @@ pub fn finish_blocks<'py>(
         .into_pyobject(py)
 }
 
-fn counts(s: &Stats) -> [u64; 7] {
-    [
-        s.v13,
-        s.t13,
-        s.merged,
-        s.blocked,
-        s.bounded,
-        s.vertices,
-        s.triangles,
-    ]
-}
-
 fn to_python(py: Python<'_>, b: BlockMesh) -> PyResult<Share<'_>> {
     Ok((
         b.grid,
@@ -128,7 +116,7 @@ fn to_python(py: Python<'_>, b: BlockMesh) -> PyResult<Share<'_>> {
         convert::rows(py, b.normals)?,
         convert::rows(py, b.triangles)?,
         PyArray1::from_vec(py, b.cubes),
-        counts(&b.stats),
+        b.stats.to_array(),
         b.covered,
     ))
 }
@@ -173,15 +161,7 @@ fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
         normals,
         triangles,
         cubes,
-        stats: Stats {
-            v13: c[0],
-            t13: c[1],
-            merged: c[2],
-            blocked: c[3],
-            bounded: c[4],
-            vertices: c[5],
-            triangles: c[6],
-        },
+        stats: Stats::from_array(c),
         covered,
     })
 }

@@ -18,6 +18,36 @@ pub struct Stats {
     pub triangles: u64,
 }
 
+impl Stats {
+    /// The counts in declaration order: v13, t13, merged, blocked, bounded, vertices, triangles.
+    /// Front ends that pass counts through plain arrays (Python tuples, JSON) use this order.
+    pub fn to_array(self) -> [u64; 7] {
+        [
+            self.v13,
+            self.t13,
+            self.merged,
+            self.blocked,
+            self.bounded,
+            self.vertices,
+            self.triangles,
+        ]
+    }
+
+    /// The inverse of [`Stats::to_array`].
+    pub fn from_array(c: [u64; 7]) -> Stats {
+        let [v13, t13, merged, blocked, bounded, vertices, triangles] = c;
+        Stats {
+            v13,
+            t13,
+            merged,
+            blocked,
+            bounded,
+            vertices,
+            triangles,
+        }
+    }
+}
+
 /// Counts of disjoint parts (parallel chunks, blocks) add up to the counts of the whole.
 impl core::ops::Add for Stats {
     type Output = Stats;

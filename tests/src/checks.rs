@@ -87,15 +87,7 @@ pub fn compare(field: &Field, mesh: &Mesh, r: &RefMesh) -> Result<(), String> {
         r.positions.len() as u64,
         r.triangles.len() as u64,
     ];
-    let got_stats = [
-        s.v13,
-        s.t13,
-        s.merged,
-        s.blocked,
-        s.bounded,
-        s.vertices,
-        s.triangles,
-    ];
+    let got_stats = s.to_array();
     if got_stats != want_stats {
         return Err(format!(
             "stats (v13, t13, merged, blocked, bounded, vertices, triangles) {got_stats:?} vs reference {want_stats:?}"
