@@ -64,6 +64,7 @@ def load(
     array: Optional[str] = ...,
     series: Optional[str] = ...,
     resample_gaps: bool = ...,
+    zarr_level: int = ...,
 ) -> Tuple[npt.NDArray[Any], Tuple[float, float, float], Tuple[float, float, float]]: ...
 
 class SliceStreamer:
