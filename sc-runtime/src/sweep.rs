@@ -438,9 +438,10 @@ impl Grid<'_> {
     }
 
     /// Whether this sweep counts the edge with lower end `p` (see [`Sweep::restrict`]).
-    #[inline]
+    #[inline(always)]
     fn owns_edge(&self, p: [usize; 3]) -> bool {
-        (0..3).all(|d| (self.own_edges[d].0..self.own_edges[d].1).contains(&p[d]))
+        let [x, y, z] = self.own_edges;
+        p[0] >= x.0 && p[0] < x.1 && p[1] >= y.0 && p[1] < y.1 && p[2] >= z.0 && p[2] < z.1
     }
 
     fn is_filled(&self, p: [usize; 3]) -> bool {

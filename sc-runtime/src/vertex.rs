@@ -18,7 +18,7 @@ pub(crate) fn crossing(a: f64, b: f64, iso: f64) -> f64 {
 }
 
 /// Where along the edge from `p` along `axis` the surface crosses; the middle at a NaN end.
-#[inline]
+#[inline(always)]
 pub(crate) fn edge_crossing<T: Scalar>(
     field: &Field<'_, T>,
     p: [usize; 3],
