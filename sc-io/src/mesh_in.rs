@@ -77,9 +77,13 @@ pub fn read(path: &Path) -> Result<TriangleMesh> {
 
 fn ply(path: &Path, file: File) -> Result<TriangleMesh> {
     let bad = |m: String| Error::file(path, format!("not a readable PLY file: {m}"));
-    let parsed = Parser::<DefaultElement>::new()
-        .read_ply(&mut BufReader::new(file))
-        .map_err(|e| bad(e.to_string()))?;
+    // ply-rs panics on some malformed headers and bodies (unchecked number parsing): a bad file
+    // must become an error naming it, not end the program.
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        Parser::<DefaultElement>::new().read_ply(&mut BufReader::new(file))
+    }))
+    .map_err(|_| bad("malformed header or data".into()))?
+    .map_err(|e| bad(e.to_string()))?;
     let number = |p: Option<&Property>| -> Option<f64> {
         Some(match p? {
             Property::Float(v) => f64::from(*v),
