@@ -143,9 +143,10 @@ mod tests {
         assert_eq!(s.layout.header_bytes, 0);
         assert_eq!(s.spacing, Some([2.0, 2.0, 3.5]));
         assert_eq!(s.origin, None);
+        // In the file's order (serde_json keeps it: zarrs turns on `preserve_order`).
         assert_eq!(
             s.iso_suggestions,
-            [("bone".to_string(), 300.5), ("skin".to_string(), 20.0)]
+            [("skin".to_string(), 20.0), ("bone".to_string(), 300.5)]
         );
         assert!(s.data.ends_with("v.raw"));
     }
