@@ -121,7 +121,7 @@ fn to_python(py: Python<'_>, b: BlockMesh) -> PyResult<Share<'_>> {
     ))
 }
 
-fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
+pub fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
     let bad = |what: &str| PyValueError::new_err(format!("block mesh: {what}"));
     #[allow(clippy::type_complexity)]
     let (grid, keys, positions, normals, triangles, cubes, c, covered): (
@@ -142,19 +142,7 @@ fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
     let positions = triples(&positions).ok_or_else(|| bad("positions are not (V, 3)"))?;
     let normals = triples(&normals).ok_or_else(|| bad("normals are not (V, 3)"))?;
     let triangles = triples(&triangles).ok_or_else(|| bad("faces are not (T, 3)"))?;
-    let ok = positions.len() == keys.len()
-        && (normals.is_empty() || normals.len() == keys.len())
-        && cubes.len() == triangles.len()
-        && keys.windows(2).all(|w| w[0] < w[1])
-        && cubes.windows(2).all(|w| w[0] <= w[1])
-        && triangles
-            .iter()
-            .flatten()
-            .all(|&v| (v as usize) < keys.len());
-    if !ok {
-        return Err(bad("its arrays do not fit together"));
-    }
-    Ok(BlockMesh {
+    let share = BlockMesh {
         grid,
         keys,
         positions,
@@ -163,7 +151,9 @@ fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
         cubes,
         stats: Stats::from_array(c),
         covered,
-    })
+    };
+    share.check().map_err(|e| bad(&e.to_string()))?;
+    Ok(share)
 }
 
 fn triples<T: Element + Copy>(a: &PyReadonlyArray2<'_, T>) -> Option<Vec<[T; 3]>> {

@@ -247,6 +247,31 @@ pub fn extract_block<T: Scalar>(
 }
 
 impl BlockMesh {
+    /// Checks the rules [`BlockMesh::merge`] relies on, for a share that crossed a process or a
+    /// file and may have been damaged on the way: one position (and normal, if any) per key, keys
+    /// strictly increasing, one owning cube per triangle in non-decreasing order, and every
+    /// triangle's indices inside the vertex list. A share from [`extract_block`] always passes.
+    pub fn check(&self) -> Result<(), Error> {
+        let n = self.keys.len();
+        let broken = |what| Err(Error::BlockMalformed { what });
+        if self.positions.len() != n || !(self.normals.is_empty() || self.normals.len() == n) {
+            return broken("the vertex arrays differ in length");
+        }
+        if self.cubes.len() != self.triangles.len() {
+            return broken("the triangle and owning-cube arrays differ in length");
+        }
+        if !self.keys.windows(2).all(|w| w[0] < w[1]) {
+            return broken("the vertex keys are not strictly increasing");
+        }
+        if !self.cubes.windows(2).all(|w| w[0] <= w[1]) {
+            return broken("the owning cubes are not in order");
+        }
+        if !self.triangles.iter().flatten().all(|&v| (v as usize) < n) {
+            return broken("a triangle refers to a vertex that is not there");
+        }
+        Ok(())
+    }
+
     /// Joins two shares of the same grid into one: the union of their vertices (in key order)
     /// and of their triangles (in cube order). Associative and commutative, so shares can be
     /// joined in any order or as a tree. Shares that own the same cube are refused.

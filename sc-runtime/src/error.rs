@@ -56,6 +56,11 @@ pub enum Error {
         /// The cube's key.
         cube: u64,
     },
+    /// A block mesh's parts do not fit together (read from a damaged file, say): `what` says how.
+    BlockMalformed {
+        /// The broken rule, in words.
+        what: &'static str,
+    },
     /// The joined blocks do not cover the grid.
     BlocksMissing {
         /// Cubes the blocks own.
@@ -108,6 +113,7 @@ impl fmt::Display for Error {
             Error::BlocksOverlap { cube } => {
                 write!(f, "two block meshes both own cube {cube}")
             }
+            Error::BlockMalformed { what } => write!(f, "the block mesh is malformed: {what}"),
             Error::BlocksMissing { covered, cubes } => write!(
                 f,
                 "the joined blocks cover {covered} of the grid's {cubes} cubes"
