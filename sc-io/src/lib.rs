@@ -19,6 +19,7 @@ pub mod error;
 pub mod mesh_in;
 pub mod progress;
 pub mod read;
+pub mod shard;
 pub mod space;
 pub mod surface;
 pub mod volume;

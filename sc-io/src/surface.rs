@@ -1,10 +1,16 @@
 //! The bridge from a typed [`Grid`] to the generic extractor.
 
-use sc_runtime::{ErrorBound, Mesh, Mode, Params, Scratch, SliceStreamer, Volume, extract_par};
+use std::path::Path;
+
+use sc_runtime::{
+    ErrorBound, Mesh, Mode, Params, Scratch, SliceStreamer, Volume, block_samples, extract_block,
+    extract_par,
+};
 
 use crate::error::Result;
 use crate::progress::Progress;
 use crate::read::stream::Stream;
+use crate::shard::{MANIFEST_NAME, Manifest, ShardEntry, write_shard};
 use crate::space::{Coordinates, World};
 use crate::volume::{Grid, Range, Sample};
 use crate::{with_dtype, with_samples};
@@ -90,6 +96,62 @@ pub fn extract_stream(
         world.place(&mut mesh);
     }
     Ok(mesh)
+}
+
+/// Extracts the surface of `grid` as shards in the directory `dir` (made if missing): blocks
+/// of `block`³ cubes, each meshed on its own and written to its own file, then the manifest
+/// [`crate::shard::merge`] joins them by. Meant for testing and for splitting work by hand;
+/// volumes too large for one machine are split by the Dask driver instead.
+pub fn extract_shards(
+    grid: &Grid,
+    request: &Request,
+    block: usize,
+    dir: &Path,
+    progress: &dyn Progress,
+) -> Result<Manifest> {
+    let world = world(grid, request);
+    let params = params(grid, request, &world);
+    let mut manifest = Manifest::new(grid.dims, &params);
+    manifest.world = world;
+    std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
+    let starts = |d: usize| (0..grid.dims[d].saturating_sub(1)).step_by(block.max(1));
+    let cubes_along = |d: usize, s: usize| s..(s + block).min(grid.dims[d] - 1);
+    progress.phase("meshing", starts(2).len() as u64);
+    for z in starts(2) {
+        for y in starts(1) {
+            for x in starts(0) {
+                let cubes = [cubes_along(0, x), cubes_along(1, y), cubes_along(2, z)];
+                let mesh = with_samples!(&grid.samples, v => block_of(v, grid.dims, cubes.clone(), &params))?;
+                let file = ShardEntry::file_name(&cubes);
+                write_shard(&dir.join(&file), &mesh, &manifest.settings)?;
+                manifest.shards.push(ShardEntry::new(file, cubes, &mesh));
+            }
+        }
+        progress.inc(1);
+    }
+    manifest.write(&dir.join(MANIFEST_NAME))?;
+    Ok(manifest)
+}
+
+/// Meshes the block of cubes `cubes` from a copy of the samples it reads.
+fn block_of<T: Sample>(
+    data: &[T],
+    dims: [usize; 3],
+    cubes: [core::ops::Range<usize>; 3],
+    params: &Params,
+) -> Result<sc_runtime::BlockMesh> {
+    let need = block_samples(dims, cubes.clone())?;
+    let [nx, ny, _] = dims;
+    let mut samples = Vec::with_capacity(need.iter().map(|r| r.len()).product());
+    for z in need[2].clone() {
+        for y in need[1].clone() {
+            let row = (z * ny + y) * nx;
+            samples.extend_from_slice(&data[row + need[0].start..row + need[0].end]);
+        }
+    }
+    let box_dims = need.clone().map(|r| r.len());
+    let volume = Volume::new(&samples, box_dims)?;
+    Ok(extract_block(&volume, need.map(|r| r.start), dims, cubes, params)?)
 }
 
 fn stream_typed<T: Sample>(

@@ -1,0 +1,567 @@
+//! Shards: one block's share of a mesh in a file of its own, plus a manifest listing them, for
+//! meshes too large for one machine. Workers write shards and keep nothing; [`merge`] joins them
+//! on a machine that can hold the result, into exactly the mesh one process makes.
+//!
+//! A shard is a NumPy `.npz` archive (uncompressed, as `numpy.savez` writes), so NumPy and
+//! anything that reads `.npy` can open it without this crate. It holds exactly a
+//! [`BlockMesh`]:
+//!
+//! | array       | dtype   | shape    | content                                               |
+//! |-------------|---------|----------|-------------------------------------------------------|
+//! | `header`    | `uint8` | `(n,)`   | UTF-8 JSON: format, version, grid, settings, counts   |
+//! | `keys`      | `<u8`   | `(V,)`   | global edge keys of the vertices, strictly increasing |
+//! | `positions` | `<f4`   | `(V, 3)` | vertex positions                                      |
+//! | `normals`   | `<f4`   | `(V, 3)` | unit normals, or `(0, 3)` without normals             |
+//! | `triangles` | `<u4`   | `(T, 3)` | indices into `keys`                                   |
+//! | `cubes`     | `<u8`   | `(T,)`   | each triangle's owning cube key, non-decreasing       |
+//!
+//! The header is JSON rather than more arrays so that a person (or `json.loads(bytes(h))`) can
+//! read what a shard is without knowing the key packing. The manifest, `manifest.json` beside
+//! the shards, names the format and version, the grid, the settings, where the mesh's
+//! coordinates are, and each shard's file and cubes; [`merge`] checks every shard against it, so
+//! a missing, damaged, foreign or duplicated shard is reported by file name instead of giving a
+//! wrong mesh.
+
+use std::fs::File;
+use std::io::{self, BufReader, Read, Seek, Write};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use npyz::WriterBuilder;
+use npyz::npz::{NpzArchive, NpzWriter};
+use sc_runtime::{BlockMesh, ErrorBound, Mesh, Mode, Params, Stats};
+use serde_json::{Value, json};
+
+use crate::atomic::AtomicFile;
+use crate::error::{Error, Result};
+use crate::space::{Space, World};
+
+/// The `format` field of a manifest.
+pub const MANIFEST_FORMAT: &str = "skelclimb-shards";
+/// The `format` field of a shard's header.
+pub const SHARD_FORMAT: &str = "skelclimb-shard";
+/// The version of both; a reader refuses others rather than guess.
+pub const VERSION: u64 = 1;
+/// The manifest's file name inside a shard directory.
+pub const MANIFEST_NAME: &str = "manifest.json";
+
+/// What every block of one mesh must share besides the grid: the extractor's parameters (the
+/// case tables excepted, which a file cannot name).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The iso value in stored units ([`Params::iso`]).
+    pub iso: f64,
+    /// Which steps run.
+    pub mode: Mode,
+    /// Whether vertices carry normals.
+    pub normals: bool,
+    /// World distance between samples along x, y, z.
+    pub spacing: [f64; 3],
+    /// World position of sample (0, 0, 0) as the extractor applied it.
+    pub origin: [f64; 3],
+    /// Step 4's bound, if any.
+    pub max_error: Option<ErrorBound>,
+}
+
+impl From<&Params> for Settings {
+    fn from(p: &Params) -> Settings {
+        Settings {
+            iso: p.iso,
+            mode: p.mode,
+            normals: p.normals,
+            spacing: p.spacing,
+            origin: p.origin,
+            max_error: p.max_error,
+        }
+    }
+}
+
+impl Settings {
+    /// The parameters these settings describe, with the default case tables.
+    pub fn params(&self) -> Params {
+        Params {
+            mode: self.mode,
+            normals: self.normals,
+            spacing: self.spacing,
+            origin: self.origin,
+            max_error: self.max_error,
+            ..Params::new(self.iso)
+        }
+    }
+
+    /// The mode's name as the command line and Python spell it.
+    pub fn mode_name(&self) -> &'static str {
+        match self.mode {
+            Mode::Embedded => "embedded",
+            Mode::Paper => "paper",
+            Mode::Steps123 => "steps123",
+        }
+    }
+
+    fn to_json(self) -> Value {
+        json!({
+            "iso": self.iso,
+            "mode": self.mode_name(),
+            "normals": self.normals,
+            "spacing": self.spacing,
+            "origin": self.origin,
+            "max_error": self.max_error.map(|b| match b {
+                ErrorBound::World(d) => json!({ "value": d, "units": "world" }),
+                ErrorBound::Voxels(d) => json!({ "value": d, "units": "voxels" }),
+            }),
+        })
+    }
+
+    fn from_json(v: &Value) -> Option<Settings> {
+        let mode = match v["mode"].as_str()? {
+            "embedded" => Mode::Embedded,
+            "paper" => Mode::Paper,
+            "steps123" => Mode::Steps123,
+            _ => return None,
+        };
+        let max_error = match &v["max_error"] {
+            Value::Null => None,
+            b => {
+                let d = b["value"].as_f64()?;
+                Some(match b["units"].as_str()? {
+                    "world" => ErrorBound::World(d),
+                    "voxels" => ErrorBound::Voxels(d),
+                    _ => return None,
+                })
+            }
+        };
+        Some(Settings {
+            iso: v["iso"].as_f64()?,
+            mode,
+            normals: v["normals"].as_bool()?,
+            spacing: triple(&v["spacing"])?,
+            origin: triple(&v["origin"])?,
+            max_error,
+        })
+    }
+}
+
+fn triple(v: &Value) -> Option<[f64; 3]> {
+    match v.as_array()?.as_slice() {
+        [a, b, c] => Some([a.as_f64()?, b.as_f64()?, c.as_f64()?]),
+        _ => None,
+    }
+}
+
+fn usizes(v: &Value) -> Option<[usize; 3]> {
+    match v.as_array()?.as_slice() {
+        [a, b, c] => Some([a, b, c].map(|x| x.as_u64().and_then(|n| usize::try_from(n).ok()))),
+        _ => None,
+    }
+    .and_then(|[a, b, c]| Some([a?, b?, c?]))
+}
+
+/// One shard as the manifest lists it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShardEntry {
+    /// The file's name, in the manifest's directory.
+    pub file: String,
+    /// The cubes the block owns (lower corners, per axis x, y, z).
+    pub cubes: [Range<usize>; 3],
+    /// Vertices in the shard, to tell a shard from another block's with the same name.
+    pub vertices: u64,
+    /// Triangles in the shard.
+    pub triangles: u64,
+}
+
+impl ShardEntry {
+    /// The entry for `block`, written to `file`, owning `cubes`.
+    pub fn new(file: impl Into<String>, cubes: [Range<usize>; 3], block: &BlockMesh) -> Self {
+        ShardEntry {
+            file: file.into(),
+            cubes,
+            vertices: block.keys.len() as u64,
+            triangles: block.triangles.len() as u64,
+        }
+    }
+
+    /// A file name for the block owning `cubes`, unique among the blocks of a grid (blocks do
+    /// not share a first cube).
+    pub fn file_name(cubes: &[Range<usize>; 3]) -> String {
+        format!(
+            "block-{}-{}-{}.npz",
+            cubes[0].start, cubes[1].start, cubes[2].start
+        )
+    }
+
+    fn count(&self) -> u64 {
+        self.cubes.iter().map(|r| r.len() as u64).product()
+    }
+}
+
+/// A manifest: the grid, the settings, where the coordinates are, and the shards.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Manifest {
+    /// Samples of the whole grid along x, y, z.
+    pub grid: [usize; 3],
+    /// The extractor's settings, the same for every shard.
+    pub settings: Settings,
+    /// The map from the shards' positions to the mesh's coordinates; identity plus the origin
+    /// unless the volume's file rotates it (then [`merge`] places the joined mesh).
+    pub world: World,
+    /// The shards, each owning a disjoint box of cubes.
+    pub shards: Vec<ShardEntry>,
+}
+
+impl Manifest {
+    /// A manifest for shards of `grid` extracted with `params`, in index × spacing + origin
+    /// coordinates, listing no shard yet.
+    pub fn new(grid: [usize; 3], params: &Params) -> Manifest {
+        Manifest {
+            grid,
+            settings: Settings::from(params),
+            world: World::new(None, params.origin, crate::space::Coordinates::Index),
+            shards: Vec::new(),
+        }
+    }
+
+    fn to_json(&self) -> Value {
+        json!({
+            "format": MANIFEST_FORMAT,
+            "version": VERSION,
+            "grid": self.grid,
+            "settings": self.settings.to_json(),
+            "world": {
+                "linear": self.world.linear,
+                "offset": self.world.offset,
+                "space": self.world.space.map(Space::name),
+            },
+            "shards": self.shards.iter().map(|s| json!({
+                "file": s.file,
+                "cubes": s.cubes.iter().map(|r| [r.start, r.end]).collect::<Vec<_>>(),
+                "vertices": s.vertices,
+                "triangles": s.triangles,
+            })).collect::<Vec<_>>(),
+        })
+    }
+
+    /// Writes the manifest to `path`, whole or not at all.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let text = serde_json::to_vec_pretty(&self.to_json()).map_err(io::Error::other);
+        AtomicFile::create(path)?.write_with(|out| out.write_all(&text?))
+    }
+
+    /// Reads a manifest and checks that its shards are distinct files owning disjoint boxes of
+    /// cubes that together cover the grid.
+    pub fn read(path: &Path) -> Result<Manifest> {
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bad = |m: &str| Error::file(path, format!("not a shard manifest: {m}"));
+        let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(&e.to_string()))?;
+        if v["format"] != MANIFEST_FORMAT {
+            return Err(bad(&format!("its format is not {MANIFEST_FORMAT:?}")));
+        }
+        if v["version"] != VERSION {
+            return Err(Error::file(
+                path,
+                format!(
+                    "manifest version {} is not the {VERSION} this skelclimb reads",
+                    v["version"]
+                ),
+            ));
+        }
+        let grid = usizes(&v["grid"]).ok_or_else(|| bad("no grid"))?;
+        let settings = Settings::from_json(&v["settings"]).ok_or_else(|| bad("no settings"))?;
+        let world = world_from_json(&v["world"]).ok_or_else(|| bad("no world placement"))?;
+        let shards = v["shards"]
+            .as_array()
+            .ok_or_else(|| bad("no list of shards"))?
+            .iter()
+            .map(|s| entry_from_json(s).ok_or_else(|| bad(&format!("a bad shard entry {s}"))))
+            .collect::<Result<Vec<_>>>()?;
+        let manifest = Manifest {
+            grid,
+            settings,
+            world,
+            shards,
+        };
+        manifest.check_cover(path)?;
+        Ok(manifest)
+    }
+
+    /// Every cube of the grid in exactly one listed shard, found from the boxes alone so that
+    /// the message can name the files.
+    fn check_cover(&self, path: &Path) -> Result<()> {
+        for s in &self.shards {
+            for (d, r) in s.cubes.iter().enumerate() {
+                if r.start > r.end || r.end > self.grid[d].saturating_sub(1) {
+                    return Err(Error::file(
+                        path,
+                        format!("shard {}: its cubes leave the grid", s.file),
+                    ));
+                }
+            }
+        }
+        let mut by_start: Vec<&ShardEntry> = self.shards.iter().filter(|s| s.count() > 0).collect();
+        by_start.sort_by_key(|s| s.cubes[2].start);
+        for (i, a) in by_start.iter().enumerate() {
+            for b in &by_start[i + 1..] {
+                if b.cubes[2].start >= a.cubes[2].end {
+                    break;
+                }
+                if a.file == b.file || (0..3).all(|d| overlap(&a.cubes[d], &b.cubes[d])) {
+                    return Err(Error::file(
+                        path,
+                        format!("shards {} and {} own the same cubes", a.file, b.file),
+                    ));
+                }
+            }
+        }
+        let covered: u64 = self.shards.iter().map(ShardEntry::count).sum();
+        let cubes: u64 = self.grid.iter().map(|&n| n.saturating_sub(1) as u64).product();
+        if covered != cubes {
+            return Err(Error::file(
+                path,
+                format!("the shards cover {covered} of the grid's {cubes} cubes: blocks are missing"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn overlap(a: &Range<usize>, b: &Range<usize>) -> bool {
+    a.start < b.end && b.start < a.end
+}
+
+fn world_from_json(v: &Value) -> Option<World> {
+    let rows = v["linear"].as_array()?;
+    let linear = match rows.as_slice() {
+        [a, b, c] => [triple(a)?, triple(b)?, triple(c)?],
+        _ => return None,
+    };
+    let space = match &v["space"] {
+        Value::Null => None,
+        s => Some(match s.as_str()? {
+            "RAS" => Space::Ras,
+            "LPS" => Space::Lps,
+            _ => return None,
+        }),
+    };
+    Some(World {
+        linear,
+        offset: triple(&v["offset"])?,
+        space,
+    })
+}
+
+fn entry_from_json(v: &Value) -> Option<ShardEntry> {
+    let file = v["file"].as_str()?;
+    // Shards live beside their manifest: a path could read any file on the machine.
+    if file.is_empty() || file.contains(['/', '\\']) || file == "." || file == ".." {
+        return None;
+    }
+    let cubes = v["cubes"].as_array()?;
+    let range = |r: &Value| -> Option<Range<usize>> {
+        let [a, b] = [&r[0], &r[1]].map(|x| x.as_u64().and_then(|n| usize::try_from(n).ok()));
+        Some(a?..b?)
+    };
+    let cubes = match cubes.as_slice() {
+        [x, y, z] => [range(x)?, range(y)?, range(z)?],
+        _ => return None,
+    };
+    Some(ShardEntry {
+        file: file.to_owned(),
+        cubes,
+        vertices: v["vertices"].as_u64()?,
+        triangles: v["triangles"].as_u64()?,
+    })
+}
+
+/// Writes `block`, meshed with `settings`, to the shard file `path`, whole or not at all.
+pub fn write_shard(path: &Path, block: &BlockMesh, settings: &Settings) -> Result<()> {
+    let header = json!({
+        "format": SHARD_FORMAT,
+        "version": VERSION,
+        "grid": block.grid,
+        "settings": settings.to_json(),
+        "stats": stats_json(&block.stats),
+        "covered": block.covered,
+    });
+    let header = serde_json::to_vec(&header).map_err(io::Error::other);
+    AtomicFile::create(path)?.write_with(|out| {
+        let header = header?;
+        let mut npz = NpzWriter::new(out);
+        put(&mut npz, "header", &[header.len()], &header)?;
+        put(&mut npz, "keys", &[block.keys.len()], &block.keys)?;
+        put(&mut npz, "positions", &[block.positions.len(), 3], block.positions.as_flattened())?;
+        put(&mut npz, "normals", &[block.normals.len(), 3], block.normals.as_flattened())?;
+        put(&mut npz, "triangles", &[block.triangles.len(), 3], block.triangles.as_flattened())?;
+        put(&mut npz, "cubes", &[block.cubes.len()], &block.cubes)?;
+        npz.zip_writer().finish().map_err(io::Error::other)?;
+        Ok(())
+    })
+}
+
+/// The seven counts by name, as the summaries spell them.
+fn stats_json(s: &Stats) -> Value {
+    json!({
+        "v13": s.v13, "t13": s.t13, "merged": s.merged, "blocked": s.blocked,
+        "bounded": s.bounded, "vertices": s.vertices, "triangles": s.triangles,
+    })
+}
+
+fn stats_from_json(v: &Value) -> Option<Stats> {
+    let n = |k: &str| v[k].as_u64();
+    Some(Stats {
+        v13: n("v13")?,
+        t13: n("t13")?,
+        merged: n("merged")?,
+        blocked: n("blocked")?,
+        bounded: n("bounded")?,
+        vertices: n("vertices")?,
+        triangles: n("triangles")?,
+    })
+}
+
+fn put<T, W>(npz: &mut NpzWriter<W>, name: &str, shape: &[usize], data: &[T]) -> io::Result<()>
+where
+    T: npyz::AutoSerialize + Copy,
+    W: Write + Seek,
+{
+    let options = npyz::zip::write::FileOptions::default()
+        .compression_method(npyz::zip::CompressionMethod::Stored)
+        .large_file(data.len() * std::mem::size_of::<T>() >= u32::MAX as usize);
+    let shape: Vec<u64> = shape.iter().map(|&n| n as u64).collect();
+    let mut w = npz.array::<T>(name, options)?.default_dtype().shape(&shape).begin_nd()?;
+    w.extend(data.iter().copied())?;
+    w.finish()
+}
+
+/// Reads a shard: its block mesh and the settings it was made with. A damaged file is an error
+/// naming it, never a wrong mesh.
+pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
+    let bad = |m: &str| Error::file(path, format!("not a readable shard: {m}"));
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut npz = NpzArchive::new(BufReader::new(file)).map_err(|e| bad(&e.to_string()))?;
+    let header: Vec<u8> = array(&mut npz, "header", 1).map_err(|m| bad(&m))?;
+    let header: Value = serde_json::from_slice(&header).map_err(|e| bad(&format!("header: {e}")))?;
+    if header["format"] != SHARD_FORMAT {
+        return Err(bad(&format!("its header's format is not {SHARD_FORMAT:?}")));
+    }
+    if header["version"] != VERSION {
+        return Err(bad(&format!(
+            "shard version {} is not the {VERSION} this skelclimb reads",
+            header["version"]
+        )));
+    }
+    let settings = Settings::from_json(&header["settings"]).ok_or_else(|| bad("no settings"))?;
+    let block = BlockMesh {
+        grid: usizes(&header["grid"]).ok_or_else(|| bad("no grid"))?,
+        stats: stats_from_json(&header["stats"]).ok_or_else(|| bad("no counts"))?,
+        covered: header["covered"].as_u64().ok_or_else(|| bad("no cube count"))?,
+        keys: array(&mut npz, "keys", 1).map_err(|m| bad(&m))?,
+        positions: rows(array(&mut npz, "positions", 3).map_err(|m| bad(&m))?),
+        normals: rows(array(&mut npz, "normals", 3).map_err(|m| bad(&m))?),
+        triangles: rows(array(&mut npz, "triangles", 3).map_err(|m| bad(&m))?),
+        cubes: array(&mut npz, "cubes", 1).map_err(|m| bad(&m))?,
+    };
+    block.check().map_err(|e| bad(&e.to_string()))?;
+    Ok((block, settings))
+}
+
+/// The array `name`, of shape `(n,)` for `width` 1 or `(n, width)` otherwise, flattened.
+fn array<T: npyz::Deserialize, R: Read + Seek>(
+    npz: &mut NpzArchive<R>,
+    name: &str,
+    width: usize,
+) -> std::result::Result<Vec<T>, String> {
+    let npy = npz
+        .by_name(name)
+        .map_err(|e| format!("array {name}: {e}"))?
+        .ok_or_else(|| format!("no array {name}"))?;
+    let shape = npy.shape().to_vec();
+    let fits = match shape.as_slice() {
+        [_] => width == 1,
+        [_, w] => *w == width as u64 && width > 1,
+        _ => false,
+    };
+    if !fits {
+        return Err(format!("array {name} has shape {shape:?}"));
+    }
+    npy.into_vec().map_err(|e| format!("array {name}: {e}"))
+}
+
+fn rows<T: Copy>(flat: Vec<T>) -> Vec<[T; 3]> {
+    flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+/// Joins the shards `manifest` lists into the whole mesh, exactly the one a single process makes,
+/// holding about the result plus one shard at a time. Every shard is checked against the
+/// manifest first: its grid, settings, cubes and counts.
+pub fn merge(manifest_path: &Path) -> Result<(Manifest, Mesh)> {
+    let manifest = Manifest::read(manifest_path)?;
+    // A binary counter of joined shares (like a merge sort's stack): each vertex and triangle
+    // is copied O(log n) times, not O(n) as a left fold would.
+    let mut stack: Vec<(u32, BlockMesh)> = Vec::new();
+    for entry in &manifest.shards {
+        let block = read_checked(&shard_path(manifest_path, entry), entry, &manifest)?;
+        let mut top = (0, block);
+        while stack.last().is_some_and(|(level, _)| *level == top.0) {
+            let (level, below) = stack.pop().expect("checked above");
+            top = (level + 1, join(below, top.1, manifest_path)?);
+        }
+        stack.push(top);
+    }
+    let mut whole = BlockMesh::default();
+    while let Some((_, b)) = stack.pop() {
+        whole = join(b, whole, manifest_path)?;
+    }
+    if whole.grid == [0; 3] {
+        whole.grid = manifest.grid;
+    }
+    let mut mesh = whole
+        .into_mesh()
+        .map_err(|e| Error::file(manifest_path, e))?;
+    if !manifest.world.is_translation() {
+        manifest.world.place(&mut mesh);
+    }
+    Ok((manifest, mesh))
+}
+
+fn join(a: BlockMesh, b: BlockMesh, manifest: &Path) -> Result<BlockMesh> {
+    a.merge(b).map_err(|e| Error::file(manifest, e))
+}
+
+/// Reads the shard `entry` names and checks that it is that block of that mesh.
+fn read_checked(path: &Path, entry: &ShardEntry, manifest: &Manifest) -> Result<BlockMesh> {
+    let (block, settings) = read_shard(path)?;
+    let refuse = |m: String| Err(Error::file(path, m));
+    if block.grid != manifest.grid {
+        return refuse(format!(
+            "a shard of a {:?} grid, but the manifest's grid is {:?}",
+            block.grid, manifest.grid
+        ));
+    }
+    if settings != manifest.settings {
+        return refuse(format!(
+            "made with other settings than the manifest's ({} rather than {})",
+            settings.to_json(),
+            manifest.settings.to_json()
+        ));
+    }
+    let [nx, ny, _] = manifest.grid.map(|n| n as u64);
+    let inside = |key: u64| {
+        let at = [key % nx, key / nx % ny, key / nx / ny];
+        (0..3).all(|d| entry.cubes[d].contains(&(at[d] as usize)))
+    };
+    let counts = [block.keys.len() as u64, block.triangles.len() as u64];
+    if block.covered != entry.count()
+        || counts != [entry.vertices, entry.triangles]
+        || !block.cubes.iter().all(|&c| inside(c))
+    {
+        return refuse(format!(
+            "not the block of cubes {:?} the manifest lists under this name",
+            entry.cubes
+        ));
+    }
+    Ok(block)
+}
+
+/// Where the shard `entry` of the manifest at `manifest_path` is.
+pub fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
+    manifest_path.parent().unwrap_or(Path::new("")).join(&entry.file)
+}
