@@ -51,6 +51,30 @@ pub enum Command {
     ///   skelclimb render bounded.ply --color-by-error steps123.ply -o error.png
     #[command(verbatim_doc_comment)]
     Render(RenderArgs),
+    /// Join the shards `extract --shards` (or `skelclimb.dask.extract(..., shards=DIR)`) wrote
+    /// into one mesh: exactly the mesh a single `extract` of the whole volume writes.
+    ///
+    /// Examples:
+    ///   skelclimb extract scan.nii.gz --iso 300 --shards parts --block 64
+    ///   skelclimb merge parts/manifest.json -o bone.ply
+    #[command(verbatim_doc_comment)]
+    Merge(MergeArgs),
+}
+
+/// Arguments of `merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The manifest (`manifest.json` in the shard directory); the shards are beside it.
+    pub manifest: PathBuf,
+    /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format.
+    #[arg(short, long, value_parser = parse_output)]
+    pub output: Output,
+    /// Write text PLY instead of binary.
+    #[arg(long)]
+    pub ascii: bool,
+    /// Also write the counts and times as JSON to this file.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
 }
 
 /// Arguments of `render`.
@@ -190,8 +214,16 @@ pub struct ExtractArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = parse_iso)]
     pub iso: Option<f64>,
     /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format.
-    #[arg(short, long, value_parser = parse_output)]
-    pub output: Output,
+    #[arg(short, long, value_parser = parse_output, required_unless_present = "shards")]
+    pub output: Option<Output>,
+    /// Instead of one mesh file, write one shard per block of cubes into this directory (made
+    /// if missing), plus `manifest.json`; `skelclimb merge` joins them into exactly the mesh
+    /// `-o` would have written.
+    #[arg(long, conflicts_with_all = ["output", "stream", "check", "ascii", "stats_json"])]
+    pub shards: Option<PathBuf>,
+    /// With --shards: cubes per block along each axis [default: 128].
+    #[arg(long, requires = "shards", value_parser = clap::value_parser!(u32).range(1..))]
+    pub block: Option<u32>,
     /// Which steps run: `embedded` merges only where the result stays a closed 2-manifold,
     /// `paper` merges every interior grey edge as the paper does, `steps123` does not merge.
     #[arg(long, value_enum, default_value_t = ModeArg::Embedded)]

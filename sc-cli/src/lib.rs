@@ -20,5 +20,6 @@ pub fn run(cli: &cli::Cli) -> Result<()> {
         cli::Command::Info(args) => cmd::info::run(args, cli.quiet),
         cli::Command::Table1(args) => cmd::table1::run(args, cli.quiet),
         cli::Command::Render(args) => render::run(args, cli.quiet),
+        cli::Command::Merge(args) => cmd::merge::run(args, cli.quiet),
     }
 }

@@ -77,10 +77,30 @@ pub fn reduction(stats: &Stats) -> f64 {
     }
 }
 
+/// Adds the mode, the bound and the counts to the JSON object `j`, under the names `extract
+/// --stats-json` uses, so that `merge --stats-json` reports them the same way.
+pub fn add_counts(j: &mut Value, mode: Mode, max_error: Option<ErrorBound>, s: &Stats) {
+    let counts = json!({
+        "mode": format!("{mode:?}").to_lowercase(),
+        "steps123": { "vertices": s.v13, "triangles": s.t13 },
+        "result": { "vertices": s.vertices, "triangles": s.triangles },
+        "merged": s.merged,
+        "blocked": s.blocked,
+        "bounded": s.bounded,
+        "max_error": max_error.map(|b| match b {
+            ErrorBound::World(d) => json!({ "value": d, "units": "world" }),
+            ErrorBound::Voxels(d) => json!({ "value": d, "units": "voxels" }),
+        }),
+        "reduction_percent": reduction(s),
+    });
+    if let (Value::Object(j), Value::Object(counts)) = (j, counts) {
+        j.extend(counts);
+    }
+}
+
 impl Summary {
     /// The JSON form: same numbers, seconds as floats.
     pub fn to_json(&self) -> Value {
-        let s = &self.stats;
         let mut j = json!({
             "input": self.input,
             "format": self.format,
@@ -89,23 +109,13 @@ impl Summary {
             "coordinates": self.coordinates,
             "dtype": self.dtype,
             "iso": self.iso,
-            "mode": format!("{:?}", self.mode).to_lowercase(),
-            "steps123": { "vertices": s.v13, "triangles": s.t13 },
-            "result": { "vertices": s.vertices, "triangles": s.triangles },
-            "merged": s.merged,
-            "blocked": s.blocked,
-            "bounded": s.bounded,
-            "max_error": self.max_error.map(|b| match b {
-                ErrorBound::World(d) => json!({ "value": d, "units": "world" }),
-                ErrorBound::Voxels(d) => json!({ "value": d, "units": "voxels" }),
-            }),
-            "reduction_percent": reduction(s),
             "seconds": {
                 "read": self.read.as_secs_f64(),
                 "extract": self.extract.as_secs_f64(),
                 "write": self.write.as_secs_f64(),
             },
         });
+        add_counts(&mut j, self.mode, self.max_error, &self.stats);
         if let Some(e) = self.edges {
             j["edges"] = e.to_json();
         }

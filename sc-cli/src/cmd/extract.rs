@@ -17,6 +17,7 @@ use sc_io::error::{Error, Result};
 use sc_io::progress::Progress;
 use sc_io::read::{self, Format, ReadOptions, stream};
 use sc_io::surface::{self, Request};
+use sc_io::volume::Grid;
 use sc_io::write::{MeshFormat, WriteOptions};
 
 /// Whether the samples of `path` would take more than half the machine's memory, so that reading
@@ -53,15 +54,24 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         }
         _ => {}
     }
-    if args.ascii && args.output.format != MeshFormat::Ply {
+    let output = match (&args.output, &args.shards) {
+        (_, Some(dir)) => return shards(args, dir, &options, quiet),
+        (Some(output), None) => output,
+        (None, None) => return Err(Error::Usage("give -o FILE or --shards DIR".into())),
+    };
+    // clap does not enforce `requires` beside `-o`'s conflict with --shards.
+    if args.block.is_some() {
+        return Err(Error::Usage("--block applies with --shards only".into()));
+    }
+    if args.ascii && output.format != MeshFormat::Ply {
         return Err(Error::Usage("--ascii applies to .ply output only".into()));
     }
     check_outputs(
         args.input.as_deref(),
-        &args.output.path,
+        &output.path,
         args.stats_json.as_deref(),
     )?;
-    let mesh_file = AtomicFile::create(&args.output.path)?;
+    let mesh_file = AtomicFile::create(&output.path)?;
     let stats_file = args
         .stats_json
         .as_deref()
@@ -88,24 +98,13 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             path.display()
         )));
     }
-    let (mut grid, iso, input) = match (&args.input, args.demo) {
-        (Some(path), _) => (
-            match &stream {
-                Some(s) => s.grid.clone(),
-                None => read::read(path, &options, &progress)?,
-            },
+    let (mut grid, iso, input) = match (&stream, &args.input) {
+        (Some(s), Some(path)) => (
+            s.grid.clone(),
             args.iso.unwrap_or_default(),
             path.display().to_string(),
         ),
-        (None, Some(demo)) => {
-            let (grid, iso) = builtin::grid(demo, args.size);
-            (
-                grid,
-                args.iso.unwrap_or(iso),
-                format!("{} {}³", builtin::name(demo), args.size),
-            )
-        }
-        (None, None) => return Err(Error::Usage("give an input volume or --demo".into())),
+        _ => load(args, &options, &progress)?,
     };
     let read_time = clock.elapsed();
     let file_dims = grid.dims;
@@ -115,14 +114,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     }
 
     let clock = Instant::now();
-    let request = Request {
-        iso,
-        mode: args.mode.into(),
-        normals: !args.no_normals,
-        threads: args.threads,
-        coordinates: args.space,
-        max_error: args.error_bound(),
-    };
+    let request = request(args, iso);
     let world = surface::world(&grid, &request);
     let mesh = match &mut stream {
         Some(s) => {
@@ -166,7 +158,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let clock = Instant::now();
     progress.phase(
         "writing",
-        approx_bytes(&mesh, args.output.format, args.ascii),
+        approx_bytes(&mesh, output.format, args.ascii),
     );
     let mesh_filled = mesh_file.fill(|out| {
         let mut counted = Counted::new(out, &progress);
@@ -174,7 +166,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             ascii: args.ascii,
             space: world.space,
         };
-        args.output.format.write(&mesh, &options, &mut counted)
+        output.format.write(&mesh, &options, &mut counted)
     })?;
     progress.finish();
     let summary = Summary {
@@ -208,6 +200,65 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     }
     if !quiet {
         println!("{summary}");
+    }
+    Ok(())
+}
+
+/// The volume read whole (or built in), its iso value, and its name for messages.
+fn load(
+    args: &ExtractArgs,
+    options: &ReadOptions,
+    progress: &dyn Progress,
+) -> Result<(Grid, f64, String)> {
+    match (&args.input, args.demo) {
+        (Some(path), _) => Ok((
+            read::read(path, options, progress)?,
+            args.iso.unwrap_or_default(),
+            path.display().to_string(),
+        )),
+        (None, Some(demo)) => {
+            let (grid, iso) = builtin::grid(demo, args.size);
+            Ok((
+                grid,
+                args.iso.unwrap_or(iso),
+                format!("{} {}³", builtin::name(demo), args.size),
+            ))
+        }
+        (None, None) => Err(Error::Usage("give an input volume or --demo".into())),
+    }
+}
+
+/// What the arguments ask the extractor for.
+fn request(args: &ExtractArgs, iso: f64) -> Request {
+    Request {
+        iso,
+        mode: args.mode.into(),
+        normals: !args.no_normals,
+        threads: args.threads,
+        coordinates: args.space,
+        max_error: args.error_bound(),
+    }
+}
+
+/// `extract --shards`: one shard per block and a manifest instead of one mesh file.
+fn shards(args: &ExtractArgs, dir: &Path, options: &ReadOptions, quiet: bool) -> Result<()> {
+    let progress = Bar::new(!quiet);
+    let (mut grid, iso, input) = load(args, options, &progress)?;
+    args.placement.apply(&mut grid);
+    if args.pad {
+        grid.pad(iso).map_err(|e| Error::file(&input, e))?;
+    }
+    let block = args.block.unwrap_or(128) as usize;
+    let manifest = surface::extract_shards(&grid, &request(args, iso), block, dir, &progress)?;
+    progress.finish();
+    if !quiet {
+        let manifest_path = dir.join(sc_io::shard::MANIFEST_NAME);
+        println!(
+            "{input}: {} shards of up to {block}³ cubes in {}; join them with `skelclimb merge {}`",
+            manifest.shards.len(),
+            dir.display(),
+            manifest_path.display()
+        );
     }
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 pub mod extract;
 pub mod info;
+pub mod merge;
 pub mod table1;
 
 /// Prints a warning on stderr; warnings are shown even with `-q`.

@@ -1,0 +1,72 @@
+//! `skelclimb merge`: shards in, one mesh out.
+
+use std::io::Write;
+use std::time::Instant;
+
+use serde_json::json;
+
+use crate::cli::MergeArgs;
+use crate::summary::{self, mode_name, thousands};
+use sc_io::atomic::AtomicFile;
+use sc_io::error::{Error, Result};
+use sc_io::shard;
+use sc_io::write::{MeshFormat, WriteOptions};
+
+/// Joins the shards the manifest lists and writes the mesh (and the counts), whole or not at all.
+pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {
+    if args.ascii && args.output.format != MeshFormat::Ply {
+        return Err(Error::Usage("--ascii applies to .ply output only".into()));
+    }
+    let mesh_file = AtomicFile::create(&args.output.path)?;
+    let stats_file = args
+        .stats_json
+        .as_deref()
+        .map(AtomicFile::create)
+        .transpose()?;
+    let clock = Instant::now();
+    let (manifest, mesh) = shard::merge(&args.manifest)?;
+    let merge_time = clock.elapsed();
+    let clock = Instant::now();
+    let options = WriteOptions {
+        ascii: args.ascii,
+        space: manifest.world.space,
+    };
+    let mesh_filled = mesh_file.fill(|out| args.output.format.write(&mesh, &options, out))?;
+    let write_time = clock.elapsed();
+    let settings = &manifest.settings;
+    let stats_filled = match stats_file {
+        Some(file) => {
+            let mut j = json!({
+                "manifest": args.manifest.display().to_string(),
+                "shards": manifest.shards.len(),
+                "dims": manifest.grid,
+                "iso": settings.iso,
+                "seconds": { "merge": merge_time.as_secs_f64(), "write": write_time.as_secs_f64() },
+            });
+            summary::add_counts(&mut j, settings.mode, settings.max_error, &mesh.stats);
+            let json = serde_json::to_vec_pretty(&j).map_err(std::io::Error::other);
+            Some(file.fill(|out| out.write_all(&json?))?)
+        }
+        None => None,
+    };
+    mesh_filled.commit()?;
+    if let Some(filled) = stats_filled {
+        filled.commit()?;
+    }
+    if !quiet {
+        println!(
+            "{}: {} shards of a {} × {} × {} grid, {}: {} vertices, {} triangles\n  time: merge {:.3} s, write {:.3} s",
+            args.manifest.display(),
+            manifest.shards.len(),
+            manifest.grid[0],
+            manifest.grid[1],
+            manifest.grid[2],
+            mode_name(settings.mode),
+            thousands(mesh.stats.vertices),
+            thousands(mesh.stats.triangles),
+            merge_time.as_secs_f64(),
+            write_time.as_secs_f64(),
+        );
+    }
+    Ok(())
+}
