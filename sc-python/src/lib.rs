@@ -7,6 +7,7 @@ mod convert;
 mod errors;
 mod extract;
 mod files;
+mod shards;
 mod streamer;
 
 use pyo3::prelude::*;
@@ -19,6 +20,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(blocks::extract_block, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::merge_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::finish_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(shards::write_shard, m)?)?;
+    m.add_function(wrap_pyfunction!(shards::write_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(shards::merge_shards, m)?)?;
     m.add_class::<streamer::SliceStreamer>()?;
     Ok(())
 }

@@ -175,3 +175,49 @@ def test_dask_with_an_error_bound():
     want = skelclimb.extract(v, 12, max_error=0.2, error_units="voxels")
     assert want.stats["bounded"] > 0
     same(got, want)
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_dask_shards_on_threads_merge_into_extract(mode, tmp_path):
+    v = blobs((40, 37, 33), 6)
+    arr = da.from_array(v, chunks=((7, 1, 20, 12), (16, 16, 5), (2, 31)))
+    with dask.config.set(scheduler="threads"):
+        manifest = skelclimb.dask.extract(arr, 12, mode=mode, shards=tmp_path / "parts")
+    assert manifest == str(tmp_path / "parts" / "manifest.json")
+    shards = sorted(p.name for p in (tmp_path / "parts").glob("*.npz"))
+    assert len(shards) > 4
+    same(skelclimb.merge_shards(manifest), skelclimb.extract(v, 12, mode=mode))
+    # A shard is a plain NumPy archive.
+    with np.load(tmp_path / "parts" / shards[0]) as z:
+        assert set(z.files) == {"header", "keys", "positions", "normals", "triangles", "cubes"}
+        assert z["positions"].shape == (len(z["keys"]), 3)
+
+
+def test_dask_shards_without_normals_and_with_a_bound(tmp_path):
+    v = blobs((30, 29, 28), 5)
+    arr = da.from_array(v, chunks=(9, 10, 11))
+    with dask.config.set(scheduler="threads"):
+        manifest = skelclimb.dask.extract(arr, 12, normals=False, max_error=0.2,
+                                          error_units="voxels", shards=tmp_path)
+    same(skelclimb.merge_shards(manifest),
+         skelclimb.extract(v, 12, normals=False, max_error=0.2, error_units="voxels"))
+
+
+def test_merge_shards_names_a_missing_or_foreign_shard(tmp_path):
+    v = blobs((30, 29, 28), 5)
+    with dask.config.set(scheduler="threads"):
+        manifest = skelclimb.dask.extract(da.from_array(v, chunks=10), 12, shards=tmp_path / "a")
+        skelclimb.dask.extract(da.from_array(v, chunks=10), 13, shards=tmp_path / "b")
+    victim = "block-10-0-10.npz"
+    os.replace(tmp_path / "b" / victim, tmp_path / "a" / victim)
+    with pytest.raises(OSError, match=f"{victim}: made with other settings"):
+        skelclimb.merge_shards(manifest)
+    os.remove(tmp_path / "a" / victim)
+    with pytest.raises(OSError, match=f"{victim}: no such file"):
+        skelclimb.merge_shards(manifest)
+
+
+def test_cluster_of_two_processes_writes_shards_that_merge_exactly(cluster, store, tmp_path):
+    path, v = store
+    manifest = skelclimb.dask.extract(da.from_zarr(path), 12, shards=tmp_path / "parts")
+    same(skelclimb.merge_shards(manifest), skelclimb.extract(v, 12))

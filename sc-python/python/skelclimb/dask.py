@@ -17,8 +17,11 @@ True
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
+from . import _native
 from ._blocks import extract_block
 
 __all__ = ["extract"]
@@ -29,6 +32,26 @@ _AFTER = 3
 
 def _mesh(samples, at, grid, cubes, options):
     return extract_block(np.asarray(samples), at=at, grid=grid, cubes=cubes, **options)
+
+
+def _native_settings(options):
+    """The settings as the native shard writer takes them (level, spacing, … as keywords)."""
+    from . import _bound
+
+    return dict(level=options["level"], spacing=options["spacing"], origin=options["origin"],
+                mode=options["mode"], normals=bool(options["normals"]),
+                max_error=_bound(options["max_error"], options["error_units"]))
+
+
+def _shard(samples, at, grid, cubes, options, directory):
+    """Meshes one block and writes it as a shard; returns only the manifest's small record, so
+    the worker keeps no mesh."""
+    share = _mesh(samples, at, grid, cubes, options)
+    return _native.write_shard(share._share, directory, cubes, **_native_settings(options))
+
+
+def _manifest(directory, grid, options, *records):
+    return str(_native.write_manifest(directory, grid, list(records), **_native_settings(options)))
 
 
 def _merge(*shares):
@@ -61,7 +84,8 @@ def _at_least(chunks, m):
 
 
 def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded",
-            normals=True, max_error=None, error_units="world", split_every=8, compute=True):
+            normals=True, max_error=None, error_units="world", split_every=8, shards=None,
+            compute=True):
     """Meshes the surface ``array == level`` of a 3-D ``dask.array``, block by block.
 
     Parameters
@@ -74,15 +98,33 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         As for :func:`skelclimb.extract`; spacing and origin are ``(x, y, z)``.
     split_every : int
         How many shares each merge task joins (the fan-in of the reduction tree).
+    shards : str or os.PathLike, optional
+        A directory (made if missing) on storage every worker can write to. Each task then
+        writes its block's share there as a shard file and returns only a small record, and
+        the result is the path of ``manifest.json`` listing them: no process holds the mesh.
+        Join the shards with :func:`skelclimb.merge_shards` or ``skelclimb merge`` on a
+        machine that can hold the result.
     compute : bool
-        Return the :class:`skelclimb.Mesh`; with ``False``, a ``dask.delayed`` object that
-        computes it, to combine with other work.
+        Return the result; with ``False``, a ``dask.delayed`` object that computes it, to
+        combine with other work.
 
     Returns
     -------
-    skelclimb.Mesh
-        Identical, vertex for vertex and triangle for triangle, to ``skelclimb.extract`` of the
-        whole array.
+    skelclimb.Mesh or str
+        The mesh, identical vertex for vertex and triangle for triangle to
+        ``skelclimb.extract`` of the whole array; with ``shards``, the manifest's path, whose
+        shards join into that same mesh.
+
+    Examples
+    --------
+    >>> import dask.array as da, numpy as np, os, tempfile, skelclimb, skelclimb.dask
+    >>> z, y, x = np.mgrid[-1:1:40j, -1:1:40j, -1:1:40j]
+    >>> ball = (0.8 - np.sqrt(x * x + y * y + z * z)).astype(np.float32)
+    >>> parts = os.path.join(tempfile.mkdtemp(), "parts")
+    >>> manifest = skelclimb.dask.extract(da.from_array(ball, chunks=16), 0.0, shards=parts)
+    >>> joined, whole = skelclimb.merge_shards(manifest), skelclimb.extract(ball, 0.0)
+    >>> bool((joined.vertices == whole.vertices).all() and (joined.faces == whole.faces).all())
+    True
     """
     import dask
     import dask.array as da
@@ -111,7 +153,14 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     halo = da.overlap.overlap(array, depth={a: (1, _AFTER) for a in range(3)}, boundary="none")
     parts = halo.to_delayed()
     zc, yc, xc = array.chunks
-    mesh = dask.delayed(_mesh, pure=True)
+    if shards is not None:
+        directory = os.fspath(shards)
+        os.makedirs(directory, exist_ok=True)
+        mesh = dask.delayed(_shard, pure=True)
+        tail = (directory,)
+    else:
+        mesh = dask.delayed(_mesh, pure=True)
+        tail = ()
     shares = []
     for iz, cz in enumerate(_cube_ranges(zc, nz)):
         for iy, cy in enumerate(_cube_ranges(yc, ny)):
@@ -120,7 +169,10 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
                     continue
                 cubes = (cx, cy, cz)
                 at = tuple(max(c[0] - 1, 0) for c in cubes)
-                shares.append(mesh(parts[iz, iy, ix], at, grid, cubes, options))
+                shares.append(mesh(parts[iz, iy, ix], at, grid, cubes, options, *tail))
+    if shards is not None:
+        result = dask.delayed(_manifest, pure=True)(directory, grid, options, *shares)
+        return result.compute() if compute else result
     merge = dask.delayed(_merge, pure=True)
     while len(shares) > 1:
         shares = [merge(*shares[i:i + split_every])

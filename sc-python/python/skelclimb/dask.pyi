@@ -1,6 +1,6 @@
 from typing import Any
 
-from . import Mesh, _Mode, _Triple
+from . import Mesh, _Mode, _Path, _Triple
 
 def extract(
     array: Any,
@@ -13,5 +13,6 @@ def extract(
     max_error: float | None = ...,
     error_units: str = ...,
     split_every: int = ...,
+    shards: _Path | None = ...,
     compute: bool = ...,
-) -> Mesh | Any: ...
+) -> Mesh | str | Any: ...

@@ -1,0 +1,110 @@
+//! Shard files for the Dask driver: each task writes its block's share through the same writer
+//! as `skelclimb extract --shards` and returns a small record, so that no worker holds the mesh;
+//! one definition of the format (`sc_io::shard`) serves the command line and Python.
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use sc_io::shard::{self, MANIFEST_NAME, Manifest, Settings, ShardEntry};
+
+use crate::blocks::from_python;
+use crate::convert;
+use crate::errors;
+use crate::extract::params;
+
+/// A manifest's record of one shard: `(file, cubes, vertices, triangles)`.
+type Record = (String, [(usize, usize); 3], u64, u64);
+
+/// Writes `share` (a tuple from `extract_block`) owning `cubes` into `directory`, with the
+/// settings it was made with; returns the record the manifest lists it by.
+#[pyfunction]
+#[pyo3(signature = (share, directory, cubes, level, spacing, origin, mode, normals, max_error=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn write_shard(
+    py: Python<'_>,
+    share: Bound<'_, PyAny>,
+    directory: PathBuf,
+    cubes: [(usize, usize); 3],
+    level: f64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    mode: &str,
+    normals: bool,
+    max_error: Option<(f64, String)>,
+) -> PyResult<Record> {
+    let settings = Settings::from(&params(level, spacing, origin, mode, normals, max_error)?);
+    let block = from_python(&share)?;
+    let cubes = cubes.map(|(a, b)| a..b);
+    let file = ShardEntry::file_name(&cubes);
+    let entry = ShardEntry::new(file, cubes, &block);
+    py.detach(|| shard::write_shard(&directory.join(&entry.file), &block, &settings))
+        .map_err(errors::io)?;
+    Ok(record(entry))
+}
+
+fn record(e: ShardEntry) -> Record {
+    (
+        e.file,
+        e.cubes.map(|r| (r.start, r.end)),
+        e.vertices,
+        e.triangles,
+    )
+}
+
+/// Writes `directory/manifest.json` for the shards `records` of a grid of `grid` samples, after
+/// checking that they cover the grid once; returns its path.
+#[pyfunction]
+#[pyo3(signature = (directory, grid, records, level, spacing, origin, mode, normals, max_error=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn write_manifest(
+    directory: PathBuf,
+    grid: [usize; 3],
+    records: Vec<Record>,
+    level: f64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    mode: &str,
+    normals: bool,
+    max_error: Option<(f64, String)>,
+) -> PyResult<PathBuf> {
+    let mut manifest = Manifest::new(
+        grid,
+        &params(level, spacing, origin, mode, normals, max_error)?,
+    );
+    manifest.shards = records
+        .into_iter()
+        .map(|(file, cubes, vertices, triangles)| ShardEntry {
+            file,
+            cubes: cubes.map(|(a, b)| a..b),
+            vertices,
+            triangles,
+        })
+        .collect();
+    let path = directory.join(MANIFEST_NAME);
+    manifest.write(&path).map_err(errors::io)?;
+    // Read back: the same checks `merge` makes, now rather than on another machine later.
+    Manifest::read(&path).map_err(errors::io)?;
+    Ok(path)
+}
+
+/// Joins the shards a manifest lists: `(vertices, faces, normals or None, stats)`.
+#[pyfunction]
+pub fn merge_shards<'py>(py: Python<'py>, manifest: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
+    let (manifest, mesh) = py
+        .detach(|| shard::merge(&manifest))
+        .map_err(errors::io)?;
+    let s = &manifest.settings;
+    let stats = crate::extract::stats(py, &mesh.stats, s.mode_name(), s.iso, manifest.grid)?;
+    let normals = match s.normals {
+        true => Some(convert::rows(py, mesh.normals)?),
+        false => None,
+    };
+    (
+        convert::rows(py, mesh.positions)?,
+        convert::rows(py, mesh.triangles)?,
+        normals,
+        stats,
+    )
+        .into_pyobject(py)
+}
