@@ -11,6 +11,9 @@ process, and each process's peak resident memory. Needs the venv of ``bench/pyth
 plus ``dask[array] distributed zarr``.
 
     python bench/dask_bench.py --size 1024 --chunk 128 --workers 2 --dir /tmp/skelclimb-dask
+
+With ``--shards`` the workers write one shard per chunk instead of returning shares, and the
+mesh is joined afterwards with ``skelclimb.merge_shards`` (its time and memory go to stderr).
 """
 
 import argparse
@@ -71,7 +74,7 @@ def run_single(path, level):
                       "triangles": int(mesh.faces.shape[0])}))
 
 
-def run_cluster(path, level, workers):
+def run_cluster(path, level, workers, shards=None):
     import dask.array as da
     import distributed
 
@@ -83,9 +86,17 @@ def run_cluster(path, level, workers):
         client.run(lambda: None)  # workers up before the clock starts
         arr = da.from_zarr(path)
         t = time.perf_counter()
-        mesh = skelclimb.dask.extract(arr, level, normals=False)
+        result = skelclimb.dask.extract(arr, level, normals=False, shards=shards)
         seconds = time.perf_counter() - t
         peaks = sorted(client.run(peak_rss_mib).values())
+    if shards is not None:
+        # Joined here, on "a machine that can hold the result", after the cluster is gone.
+        t = time.perf_counter()
+        mesh = skelclimb.merge_shards(result)
+        print(f"merge_shards of {result}: {time.perf_counter() - t:.1f} s, peak RSS of this "
+              f"process {peak_rss_mib():.0f} MiB", file=sys.stderr)
+    else:
+        mesh = result
     same = (np.array_equal(mesh.faces, np.load(path + ".single-faces.npy"))
             and np.array_equal(mesh.vertices, np.load(path + ".single-verts.npy")))
     mesh_mib = (mesh.faces.nbytes + mesh.vertices.nbytes) / 2**20
@@ -99,6 +110,8 @@ def main():
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--level", type=float, default=50)
     p.add_argument("--dir", default="/tmp/skelclimb-dask")
+    p.add_argument("--shards", action="store_true",
+                   help="workers write shards (in DIR/shards) instead of returning shares")
     p.add_argument("--single", action="store_true", help=argparse.SUPPRESS)
     a = p.parse_args()
     path = os.path.join(a.dir, f"balls{a.size}-c{a.chunk}.zarr")
@@ -110,13 +123,15 @@ def main():
         [sys.executable, __file__, "--single", "--size", str(a.size), "--chunk", str(a.chunk),
          "--level", str(a.level), "--dir", a.dir],
         check=True, capture_output=True, text=True).stdout)
-    seconds, peaks, same, triangles, mesh_mib = run_cluster(path, a.level, a.workers)
+    shards = os.path.join(a.dir, "shards") if a.shards else None
+    seconds, peaks, same, triangles, mesh_mib = run_cluster(path, a.level, a.workers, shards)
     gib = a.size**3 / 2**30
     print(f"| run | wall time | time × cores / single | peak RSS per process |")
     print(f"|---|---|---|---|")
     print(f"| 1 process (synchronous) | {single['seconds']:.1f} s | 1.00 | "
           f"{single['peak_mib']:.0f} MiB |")
-    print(f"| LocalCluster, {a.workers} processes | {seconds:.1f} s | "
+    how = ", shards" if a.shards else ""
+    print(f"| LocalCluster, {a.workers} processes{how} | {seconds:.1f} s | "
           f"{seconds * a.workers / single['seconds']:.2f} | "
           f"{', '.join(f'{m:.0f}' for m in peaks)} MiB |")
     print(f"\n{a.size}³ uint8 ({gib:.2f} GiB) in {a.chunk}³ chunks, level {a.level:g}: "
