@@ -62,11 +62,17 @@ fn knot_shards_merge_into_the_whole_mesh() {
             whole == read(d, "joined.ply"),
             "{mode} {extra:?} block {block}: the mesh bytes differ"
         );
-        let json = |name| -> serde_json::Value {
-            serde_json::from_slice(&read(d, name)).unwrap()
-        };
+        let json = |name| -> serde_json::Value { serde_json::from_slice(&read(d, name)).unwrap() };
         let (w, j) = (json("whole.json"), json("joined.json"));
-        for key in ["mode", "steps123", "result", "merged", "blocked", "bounded", "max_error"] {
+        for key in [
+            "mode",
+            "steps123",
+            "result",
+            "merged",
+            "blocked",
+            "bounded",
+            "max_error",
+        ] {
             assert_eq!(w[key], j[key], "{mode} {extra:?}: {key}");
         }
     }
@@ -92,7 +98,11 @@ fn every_format_merges_exactly() {
             .success();
         assert!(whole == read(d, out), "{out}");
     }
-    skelclimb(d).args(knot).args(["-o", "a.ply", "--ascii"]).assert().success();
+    skelclimb(d)
+        .args(knot)
+        .args(["-o", "a.ply", "--ascii"])
+        .assert()
+        .success();
     skelclimb(d)
         .args(["merge", "parts/manifest.json", "-o", "b.ply", "--ascii"])
         .assert()
@@ -108,7 +118,11 @@ fn a_rotated_scan_is_placed_as_extract_places_it() {
     let input = fixture("itk-t1-mri.nii.gz");
     let input = input.to_str().unwrap();
     let args = ["extract", input, "--iso", "47.5"];
-    skelclimb(d).args(args).args(["-o", "whole.ply"]).assert().success();
+    skelclimb(d)
+        .args(args)
+        .args(["-o", "whole.ply"])
+        .assert()
+        .success();
     skelclimb(d)
         .args(args)
         .args(["--shards", "parts", "--block", "50"])
@@ -212,24 +226,41 @@ fn random_splits_of_a_real_crop_merge_exactly() {
         std::fs::create_dir(&parts).unwrap();
         random_shards(&parts, &samples, dims, &params, seed as u64 + 1);
         skelclimb(d)
-            .args(["extract", raw.to_str().unwrap(), "--dims", "40,40,30", "--dtype", "u8"])
+            .args([
+                "extract",
+                raw.to_str().unwrap(),
+                "--dims",
+                "40,40,30",
+                "--dtype",
+                "u8",
+            ])
             .args(["--iso", "20", "--mode", name, "-o", "whole.ply"])
             .assert()
             .success();
         skelclimb(d)
-            .args(["merge", &format!("parts-{name}/manifest.json"), "-o", "joined.ply"])
+            .args([
+                "merge",
+                &format!("parts-{name}/manifest.json"),
+                "-o",
+                "joined.ply",
+            ])
             .assert()
             .success();
         let whole = read(d, "whole.ply");
         assert!(whole.len() > 10_000, "{name}");
-        assert!(whole == read(d, "joined.ply"), "{name}: the mesh bytes differ");
+        assert!(
+            whole == read(d, "joined.ply"),
+            "{name}: the mesh bytes differ"
+        );
     }
 }
 
 /// Shards of the 20³ sphere in blocks of 8 (27 shards) in `d/name`.
 fn sphere_shards(d: &Path, name: &str, extra: &[&str]) {
     skelclimb(d)
-        .args(["extract", "--demo", "sphere", "--size", "20", "--block", "8"])
+        .args([
+            "extract", "--demo", "sphere", "--size", "20", "--block", "8",
+        ])
         .args(["--shards", name])
         .args(extra)
         .assert()
@@ -271,7 +302,11 @@ fn a_damaged_shard_is_named() {
     let bytes = std::fs::read(&shard).unwrap();
     // Cut short, and the keys' order broken: both are refused, naming the file.
     std::fs::write(&shard, &bytes[..bytes.len() / 2]).unwrap();
-    merge_fails(d, "p/manifest.json", "block-8-8-8.npz: not a readable shard");
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "block-8-8-8.npz: not a readable shard",
+    );
     let (mut block, settings) = {
         std::fs::write(&shard, &bytes).unwrap();
         sc_io::shard::read_shard(&shard).unwrap()
@@ -288,17 +323,31 @@ fn a_shard_of_another_mesh_is_named() {
     sphere_shards(d, "p", &[]);
     sphere_shards(d, "paper", &["--mode", "paper"]);
     std::fs::copy(d.join("paper/block-0-8-0.npz"), d.join("p/block-0-8-0.npz")).unwrap();
-    merge_fails(d, "p/manifest.json", "block-0-8-0.npz: made with other settings");
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "block-0-8-0.npz: made with other settings",
+    );
     skelclimb(d)
-        .args(["extract", "--demo", "sphere", "--size", "21", "--block", "8"])
+        .args([
+            "extract", "--demo", "sphere", "--size", "21", "--block", "8",
+        ])
         .args(["--shards", "big"])
         .assert()
         .success();
     std::fs::copy(d.join("big/block-0-8-0.npz"), d.join("p/block-0-8-0.npz")).unwrap();
-    merge_fails(d, "p/manifest.json", "block-0-8-0.npz: a shard of a [21, 21, 21] grid");
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "block-0-8-0.npz: a shard of a [21, 21, 21] grid",
+    );
     // The right mesh, but another block's file under this block's name.
     std::fs::copy(d.join("p/block-8-8-8.npz"), d.join("p/block-0-8-0.npz")).unwrap();
-    merge_fails(d, "p/manifest.json", "block-0-8-0.npz: not the block of cubes");
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "block-0-8-0.npz: not the block of cubes",
+    );
 }
 
 #[test]
@@ -317,10 +366,18 @@ fn overlapping_and_missing_blocks_are_refused() {
         let first = s[0].clone();
         s.push(first);
     });
-    merge_fails(d, "p/manifest.json", "shards block-0-0-0.npz and block-0-0-0.npz own the same cubes");
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "shards block-0-0-0.npz and block-0-0-0.npz own the same cubes",
+    );
     std::fs::write(&manifest, &original).unwrap();
     edit_manifest(&manifest, |s| s[1]["file"] = "../p/block-0-0-0.npz".into());
-    merge_fails(d, "p/manifest.json", "not a shard manifest: a bad shard entry");
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "not a shard manifest: a bad shard entry",
+    );
     std::fs::write(&manifest, b"{\"format\": \"something else\"}").unwrap();
     merge_fails(d, "p/manifest.json", "manifest.json: not a shard manifest");
 }

@@ -312,11 +312,17 @@ impl Manifest {
             }
         }
         let covered: u64 = self.shards.iter().map(ShardEntry::count).sum();
-        let cubes: u64 = self.grid.iter().map(|&n| n.saturating_sub(1) as u64).product();
+        let cubes: u64 = self
+            .grid
+            .iter()
+            .map(|&n| n.saturating_sub(1) as u64)
+            .product();
         if covered != cubes {
             return Err(Error::file(
                 path,
-                format!("the shards cover {covered} of the grid's {cubes} cubes: blocks are missing"),
+                format!(
+                    "the shards cover {covered} of the grid's {cubes} cubes: blocks are missing"
+                ),
             ));
         }
         Ok(())
@@ -387,9 +393,24 @@ pub fn write_shard(path: &Path, block: &BlockMesh, settings: &Settings) -> Resul
         let mut npz = NpzWriter::new(out);
         put(&mut npz, "header", &[header.len()], &header)?;
         put(&mut npz, "keys", &[block.keys.len()], &block.keys)?;
-        put(&mut npz, "positions", &[block.positions.len(), 3], block.positions.as_flattened())?;
-        put(&mut npz, "normals", &[block.normals.len(), 3], block.normals.as_flattened())?;
-        put(&mut npz, "triangles", &[block.triangles.len(), 3], block.triangles.as_flattened())?;
+        put(
+            &mut npz,
+            "positions",
+            &[block.positions.len(), 3],
+            block.positions.as_flattened(),
+        )?;
+        put(
+            &mut npz,
+            "normals",
+            &[block.normals.len(), 3],
+            block.normals.as_flattened(),
+        )?;
+        put(
+            &mut npz,
+            "triangles",
+            &[block.triangles.len(), 3],
+            block.triangles.as_flattened(),
+        )?;
         put(&mut npz, "cubes", &[block.cubes.len()], &block.cubes)?;
         npz.zip_writer().finish().map_err(io::Error::other)?;
         Ok(())
@@ -424,9 +445,13 @@ where
 {
     let options = npyz::zip::write::FileOptions::default()
         .compression_method(npyz::zip::CompressionMethod::Stored)
-        .large_file(data.len() * std::mem::size_of::<T>() >= u32::MAX as usize);
+        .large_file(std::mem::size_of_val(data) >= u32::MAX as usize);
     let shape: Vec<u64> = shape.iter().map(|&n| n as u64).collect();
-    let mut w = npz.array::<T>(name, options)?.default_dtype().shape(&shape).begin_nd()?;
+    let mut w = npz
+        .array::<T>(name, options)?
+        .default_dtype()
+        .shape(&shape)
+        .begin_nd()?;
     w.extend(data.iter().copied())?;
     w.finish()
 }
@@ -438,7 +463,8 @@ pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
     let mut npz = NpzArchive::new(BufReader::new(file)).map_err(|e| bad(&e.to_string()))?;
     let header: Vec<u8> = array(&mut npz, "header", 1).map_err(|m| bad(&m))?;
-    let header: Value = serde_json::from_slice(&header).map_err(|e| bad(&format!("header: {e}")))?;
+    let header: Value =
+        serde_json::from_slice(&header).map_err(|e| bad(&format!("header: {e}")))?;
     if header["format"] != SHARD_FORMAT {
         return Err(bad(&format!("its header's format is not {SHARD_FORMAT:?}")));
     }
@@ -452,7 +478,9 @@ pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
     let block = BlockMesh {
         grid: usizes(&header["grid"]).ok_or_else(|| bad("no grid"))?,
         stats: stats_from_json(&header["stats"]).ok_or_else(|| bad("no counts"))?,
-        covered: header["covered"].as_u64().ok_or_else(|| bad("no cube count"))?,
+        covered: header["covered"]
+            .as_u64()
+            .ok_or_else(|| bad("no cube count"))?,
         keys: array(&mut npz, "keys", 1).map_err(|m| bad(&m))?,
         positions: rows(array(&mut npz, "positions", 3).map_err(|m| bad(&m))?),
         normals: rows(array(&mut npz, "normals", 3).map_err(|m| bad(&m))?),
@@ -563,5 +591,8 @@ fn read_checked(path: &Path, entry: &ShardEntry, manifest: &Manifest) -> Result<
 
 /// Where the shard `entry` of the manifest at `manifest_path` is.
 pub fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
-    manifest_path.parent().unwrap_or(Path::new("")).join(&entry.file)
+    manifest_path
+        .parent()
+        .unwrap_or(Path::new(""))
+        .join(&entry.file)
 }

@@ -151,7 +151,13 @@ fn block_of<T: Sample>(
     }
     let box_dims = need.clone().map(|r| r.len());
     let volume = Volume::new(&samples, box_dims)?;
-    Ok(extract_block(&volume, need.map(|r| r.start), dims, cubes, params)?)
+    Ok(extract_block(
+        &volume,
+        need.map(|r| r.start),
+        dims,
+        cubes,
+        params,
+    )?)
 }
 
 fn stream_typed<T: Sample>(

@@ -91,9 +91,7 @@ pub fn write_manifest(
 /// Joins the shards a manifest lists: `(vertices, faces, normals or None, stats)`.
 #[pyfunction]
 pub fn merge_shards<'py>(py: Python<'py>, manifest: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
-    let (manifest, mesh) = py
-        .detach(|| shard::merge(&manifest))
-        .map_err(errors::io)?;
+    let (manifest, mesh) = py.detach(|| shard::merge(&manifest)).map_err(errors::io)?;
     let s = &manifest.settings;
     let stats = crate::extract::stats(py, &mesh.stats, s.mode_name(), s.iso, manifest.grid)?;
     let normals = match s.normals {

@@ -156,10 +156,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     };
 
     let clock = Instant::now();
-    progress.phase(
-        "writing",
-        approx_bytes(&mesh, output.format, args.ascii),
-    );
+    progress.phase("writing", approx_bytes(&mesh, output.format, args.ascii));
     let mesh_filled = mesh_file.fill(|out| {
         let mut counted = Counted::new(out, &progress);
         let options = WriteOptions {
