@@ -596,3 +596,33 @@ pub fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
         .unwrap_or(Path::new(""))
         .join(&entry.file)
 }
+
+#[cfg(test)]
+mod tests {
+    use sc_runtime::{Volume, demo, extract_block};
+
+    use super::*;
+
+    /// A shard reads back as exactly the block written, counts and settings included, and
+    /// NumPy's layout (shapes, dtypes) is what the table above says.
+    #[test]
+    fn a_shard_reads_back_exactly() {
+        let v = demo::torus(20);
+        let mut params = Params::new(v.iso);
+        params.max_error = Some(ErrorBound::Voxels(0.25));
+        params.spacing = [0.5, 1.0, 2.0];
+        let volume = Volume::new(&v.data, v.dims).unwrap();
+        let block = extract_block(&volume, [0; 3], v.dims, [3..9, 0..19, 4..12], &params).unwrap();
+        assert!(block.triangles.len() > 20 && block.stats.bounded + block.stats.merged > 0);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.npz");
+        write_shard(&path, &block, &Settings::from(&params)).unwrap();
+        let (back, settings) = read_shard(&path).unwrap();
+        assert_eq!(back, block);
+        assert_eq!(settings, Settings::from(&params));
+        let mut npz = NpzArchive::open(&path).unwrap();
+        let positions = npz.by_name("positions").unwrap().unwrap();
+        assert_eq!(positions.shape(), [block.keys.len() as u64, 3]);
+        assert_eq!(positions.dtype().descr(), "'<f4'");
+    }
+}

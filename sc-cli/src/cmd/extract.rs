@@ -1,6 +1,5 @@
 //! `skelclimb extract`.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -183,18 +182,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         paper_knot,
         edges: args.check.then(|| EdgeReport::of(&mesh.triangles)),
     };
-    // Both outputs are complete before either is renamed: all or nothing.
-    let stats_filled = match stats_file {
-        Some(file) => {
-            let json = serde_json::to_vec_pretty(&summary.to_json()).map_err(std::io::Error::other);
-            Some(file.fill(|out| out.write_all(&json?))?)
-        }
-        None => None,
-    };
-    mesh_filled.commit()?;
-    if let Some(filled) = stats_filled {
-        filled.commit()?;
-    }
+    super::commit_with_report(mesh_filled, stats_file, || summary.to_json())?;
     if !quiet {
         println!("{summary}");
     }

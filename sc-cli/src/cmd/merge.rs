@@ -1,6 +1,5 @@
 //! `skelclimb merge`: shards in, one mesh out.
 
-use std::io::Write;
 use std::time::Instant;
 
 use serde_json::json;
@@ -34,25 +33,17 @@ pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {
     let mesh_filled = mesh_file.fill(|out| args.output.format.write(&mesh, &options, out))?;
     let write_time = clock.elapsed();
     let settings = &manifest.settings;
-    let stats_filled = match stats_file {
-        Some(file) => {
-            let mut j = json!({
-                "manifest": args.manifest.display().to_string(),
-                "shards": manifest.shards.len(),
-                "dims": manifest.grid,
-                "iso": settings.iso,
-                "seconds": { "merge": merge_time.as_secs_f64(), "write": write_time.as_secs_f64() },
-            });
-            summary::add_counts(&mut j, settings.mode, settings.max_error, &mesh.stats);
-            let json = serde_json::to_vec_pretty(&j).map_err(std::io::Error::other);
-            Some(file.fill(|out| out.write_all(&json?))?)
-        }
-        None => None,
-    };
-    mesh_filled.commit()?;
-    if let Some(filled) = stats_filled {
-        filled.commit()?;
-    }
+    super::commit_with_report(mesh_filled, stats_file, || {
+        let mut j = json!({
+            "manifest": args.manifest.display().to_string(),
+            "shards": manifest.shards.len(),
+            "dims": manifest.grid,
+            "iso": settings.iso,
+            "seconds": { "merge": merge_time.as_secs_f64(), "write": write_time.as_secs_f64() },
+        });
+        summary::add_counts(&mut j, settings.mode, settings.max_error, &mesh.stats);
+        j
+    })?;
     if !quiet {
         println!(
             "{}: {} shards of a {} × {} × {} grid, {}: {} vertices, {} triangles\n  time: merge {:.3} s, write {:.3} s",

@@ -9,3 +9,26 @@ pub mod table1;
 pub fn warn(message: impl std::fmt::Display) {
     eprintln!("skelclimb: warning: {message}");
 }
+
+/// Renames the complete mesh file over its target, and writes the JSON report `json` (if a file
+/// was asked for) first: both are complete before either is renamed, all or nothing.
+pub fn commit_with_report(
+    mesh: sc_io::atomic::Filled,
+    report: Option<sc_io::atomic::AtomicFile>,
+    json: impl FnOnce() -> serde_json::Value,
+) -> sc_io::Result<()> {
+    use std::io::Write;
+
+    let report = match report {
+        Some(file) => {
+            let bytes = serde_json::to_vec_pretty(&json()).map_err(std::io::Error::other);
+            Some(file.fill(|out| out.write_all(&bytes?))?)
+        }
+        None => None,
+    };
+    mesh.commit()?;
+    if let Some(filled) = report {
+        filled.commit()?;
+    }
+    Ok(())
+}
