@@ -30,71 +30,66 @@ __all__ = ["extract"]
 _AFTER = 3
 
 
-def _slabs(block, axis):
-    """What ``block``'s neighbours along ``axis`` need of it: its first ``_AFTER`` samples (for
-    the block before) and its last one (for the block after)."""
-    first, last = [slice(None)] * 3, [slice(None)] * 3
-    first[axis], last[axis] = slice(0, _AFTER), slice(-1, None)
-    return np.asarray(block[tuple(first)]), np.asarray(block[tuple(last)])
+def _grown(block, halos, cut=None):
+    """``block`` extended along each axis of ``halos`` in turn. A halo is ``(axis, before,
+    after)``: the slabs of the neighbouring blocks along that axis (each already extended along
+    the axes before it), ``None`` at the grid's ends. With ``cut = (axis, slice)``, only that
+    slice along another axis is built: cutting before joining keeps the copy small."""
+    def part(a):
+        if cut is None:
+            return np.asarray(a)
+        index = [slice(None)] * 3
+        index[cut[0]] = cut[1]
+        return np.asarray(a[tuple(index)])
 
-
-def _extend(block, axis, before, after):
-    """``block`` with the last sample of the block before it along ``axis`` and the first
-    ``_AFTER`` of the block after it (``None`` at the grid's ends)."""
-    parts = [before[1]] if before is not None else []
-    parts.append(np.asarray(block))
-    if after is not None:
-        parts.append(after[0])
-    return np.concatenate(parts, axis=axis) if len(parts) > 1 else parts[0]
-
-
-def _edges_of(blocks, axis):
-    """Per block (an object array of delayed chunks), a task giving its slabs along ``axis``;
-    ``None`` when the axis has one block and so no neighbours."""
-    import dask
-
-    if blocks.shape[axis] == 1:
-        return None
-    slabs = dask.delayed(_slabs, pure=True)
-    out = np.empty(blocks.shape, object)
-    for idx in np.ndindex(blocks.shape):
-        out[idx] = slabs(blocks[idx], axis)
+    out = part(block)
+    for axis, before, after in halos:
+        pieces = [part(before[1])] if before is not None else []
+        pieces.append(out)
+        if after is not None:
+            pieces.append(part(after[0]))
+        if len(pieces) > 1:
+            out = np.concatenate(pieces, axis=axis)
     return out
 
 
-def _neighbours(edges, idx, axis):
-    """The slabs of the blocks before and after ``idx`` along ``axis`` (``None`` past the
-    ends)."""
-    if edges is None:
-        return None, None
-    i = idx[axis]
-    step = tuple(int(a == axis) for a in range(3))
-    before = edges[tuple(c - s for c, s in zip(idx, step))] if i > 0 else None
-    after = (edges[tuple(c + s for c, s in zip(idx, step))]
-             if i + 1 < edges.shape[axis] else None)
-    return before, after
+def _slabs(block, axis, *halos):
+    """What ``block``'s neighbours along ``axis`` need of it, extended by ``halos``: its first
+    ``_AFTER`` samples (for the block before) and its last one (for the block after)."""
+    return (_grown(block, halos, (axis, slice(0, _AFTER))),
+            _grown(block, halos, (axis, slice(-1, None))))
 
 
-def _halo(blocks, axes):
-    """The blocks extended by their neighbours' slabs along each of ``axes`` in turn."""
+def _halos(blocks):
+    """Per block (an object array of delayed chunks), its halos along x, then y, then z: one
+    slab task per block and axis, fed by the halos before it, so that the edge and corner
+    samples come along. Only the chunks themselves and thin slabs are ever held, never extended
+    copies, and only the slabs travel between workers."""
     import dask
 
-    extend = dask.delayed(_extend, pure=True)
-    for axis in axes:
-        edges = _edges_of(blocks, axis)
-        if edges is None:
+    slabs = dask.delayed(_slabs, pure=True)
+    halos = np.empty(blocks.shape, object)
+    for idx in np.ndindex(blocks.shape):
+        halos[idx] = []
+    for axis in (2, 1, 0):
+        n = blocks.shape[axis]
+        if n == 1:
             continue
-        out = np.empty(blocks.shape, object)
+        edges = np.empty(blocks.shape, object)
         for idx in np.ndindex(blocks.shape):
-            out[idx] = extend(blocks[idx], axis, *_neighbours(edges, idx, axis))
-        blocks = out
-    return blocks
+            edges[idx] = slabs(blocks[idx], axis, *halos[idx])
+        for idx in np.ndindex(blocks.shape):
+            step = tuple(int(a == axis) for a in range(3))
+            i = idx[axis]
+            before = edges[tuple(c - s for c, s in zip(idx, step))] if i > 0 else None
+            after = edges[tuple(c + s for c, s in zip(idx, step))] if i + 1 < n else None
+            halos[idx] = halos[idx] + [(axis, before, after)]
+    return halos
 
 
-def _mesh(samples, before, after, at, grid, cubes, options):
-    """Meshes a block, given its samples extended along x and y and its z-neighbours' slabs."""
-    samples = _extend(samples, 0, before, after)
-    return extract_block(samples, at=at, grid=grid, cubes=cubes, **options)
+def _mesh(block, halos, at, grid, cubes, options):
+    """Meshes a block from its chunk and its halos."""
+    return extract_block(_grown(block, halos), at=at, grid=grid, cubes=cubes, **options)
 
 
 def _native_settings(options):
@@ -106,10 +101,10 @@ def _native_settings(options):
                 max_error=_bound(options["max_error"], options["error_units"]))
 
 
-def _shard(samples, before, after, at, grid, cubes, options, directory):
+def _shard(block, halos, at, grid, cubes, options, directory):
     """Meshes one block and writes it as a shard; returns only the manifest's small record, so
     the worker keeps no mesh."""
-    share = _mesh(samples, before, after, at, grid, cubes, options)
+    share = _mesh(block, halos, at, grid, cubes, options)
     return _native.write_shard(share._share, directory, cubes, **_native_settings(options))
 
 
@@ -209,14 +204,11 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     options = dict(level=level, spacing=spacing, origin=origin, mode=mode, normals=normals,
                    max_error=max_error, error_units=error_units)
     # Each task gets its chunk plus the halo extract_block reads (one sample before, up to
-    # three after), built one axis at a time: a chunk's edge slabs along x go to its two
-    # x-neighbours, which append them; then the same along y of those, then z (inside the
-    # meshing task), which brings the edge and corner samples along too. That is about seven
-    # tasks per chunk where dask.array.overlap makes some 24, and only thin slabs travel
-    # between workers; every chunk is read once.
+    # three after), as thin slabs from its neighbours, built one axis at a time (see _halos):
+    # about five tasks per chunk where dask.array.overlap makes some 24, every chunk read once.
     array = array.rechunk(tuple(_at_least(c, _AFTER) for c in array.chunks))
-    parts = _halo(array.to_delayed(), axes=(2, 1))
-    edges = _edges_of(parts, 0)
+    parts = array.to_delayed()
+    halos = _halos(parts)
     zc, yc, xc = array.chunks
     if shards is not None:
         directory = os.fspath(shards)
@@ -234,8 +226,8 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
                     continue
                 cubes = (cx, cy, cz)
                 at = tuple(max(c[0] - 1, 0) for c in cubes)
-                around = _neighbours(edges, (iz, iy, ix), 0)
-                shares.append(mesh(parts[iz, iy, ix], *around, at, grid, cubes, options, *tail))
+                shares.append(mesh(parts[iz, iy, ix], halos[iz, iy, ix], at, grid, cubes, options,
+                                   *tail))
     if shards is not None:
         result = dask.delayed(_manifest, pure=True)(directory, grid, options, *shares)
         return result.compute() if compute else result
