@@ -218,7 +218,9 @@ pub struct ExtractArgs {
     pub output: Option<Output>,
     /// Instead of one mesh file, write one shard per block of cubes into this directory (made
     /// if missing), plus `manifest.json`; `skelclimb merge` joins them into exactly the mesh
-    /// `-o` would have written.
+    /// `-o` would have written. The volume is read whole and the blocks meshed one after
+    /// another: this is for splitting work by hand and for tests; volumes larger than one
+    /// machine are split by the Python package's Dask driver (`shards=`).
     #[arg(long, conflicts_with_all = ["output", "stream", "check", "ascii", "stats_json"])]
     pub shards: Option<PathBuf>,
     /// With --shards: cubes per block along each axis [default: 128].

@@ -244,3 +244,31 @@ fn overlapping_or_missing_blocks_are_refused() {
     let d = share(&vol, &params, [0..19, 0..19, 10..19]);
     assert!(matches!(c.merge(d), Err(Error::BlocksDiffer)));
 }
+
+/// `BlockMesh::check` passes every share `extract_block` makes and refuses each way a share
+/// read from a damaged file could break the rules `merge` relies on.
+#[test]
+fn check_refuses_broken_shares() {
+    let vol = brainsmall_crop();
+    let share = share(&vol, &Params::new(20.0), [3..20, 5..30, 2..17]);
+    assert!(share.keys.len() > 100);
+    assert_eq!(share.check(), Ok(()));
+    let broken: [(&str, fn(&mut BlockMesh)); 5] = [
+        ("differ in length", |b| {
+            b.positions.pop();
+        }),
+        ("owning-cube", |b| {
+            b.cubes.pop();
+        }),
+        ("strictly increasing", |b| b.keys.swap(0, 1)),
+        ("not in order", |b| b.cubes.reverse()),
+        ("not there", |b| b.triangles[0][1] = b.keys.len() as u32),
+    ];
+    for (needle, damage) in broken {
+        let mut b = share.clone();
+        damage(&mut b);
+        let err = b.check().unwrap_err();
+        assert!(matches!(err, Error::BlockMalformed { .. }), "{err}");
+        assert!(err.to_string().contains(needle), "{needle}: {err}");
+    }
+}
