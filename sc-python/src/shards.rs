@@ -16,24 +16,27 @@ use crate::extract::params;
 /// A manifest's record of one shard: `(file, cubes, vertices, triangles)`.
 type Record = (String, [(usize, usize); 3], u64, u64);
 
+/// The settings of every block of one mesh, as `skelclimb.dask` passes them: `(level, spacing,
+/// origin, mode, normals, max_error)`, the arguments of `extract_block` in its order.
+type SettingsArgs = (f64, [f64; 3], [f64; 3], String, bool, Option<(f64, String)>);
+
+fn settings(
+    (level, spacing, origin, mode, normals, max_error): SettingsArgs,
+) -> PyResult<sc_runtime::Params> {
+    params(level, spacing, origin, &mode, normals, max_error)
+}
+
 /// Writes `share` (a tuple from `extract_block`) owning `cubes` into `directory`, with the
 /// settings it was made with; returns the record the manifest lists it by.
 #[pyfunction]
-#[pyo3(signature = (share, directory, cubes, level, spacing, origin, mode, normals, max_error=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn write_shard(
     py: Python<'_>,
     share: Bound<'_, PyAny>,
     directory: PathBuf,
     cubes: [(usize, usize); 3],
-    level: f64,
-    spacing: [f64; 3],
-    origin: [f64; 3],
-    mode: &str,
-    normals: bool,
-    max_error: Option<(f64, String)>,
+    made_with: SettingsArgs,
 ) -> PyResult<Record> {
-    let settings = Settings::from(&params(level, spacing, origin, mode, normals, max_error)?);
+    let settings = Settings::from(&settings(made_with)?);
     let block = from_python(&share)?;
     let cubes = cubes.map(|(a, b)| a..b);
     let file = ShardEntry::file_name(&cubes);
@@ -55,23 +58,13 @@ fn record(e: ShardEntry) -> Record {
 /// Writes `directory/manifest.json` for the shards `records` of a grid of `grid` samples, after
 /// checking that they cover the grid once; returns its path.
 #[pyfunction]
-#[pyo3(signature = (directory, grid, records, level, spacing, origin, mode, normals, max_error=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn write_manifest(
     directory: PathBuf,
     grid: [usize; 3],
     records: Vec<Record>,
-    level: f64,
-    spacing: [f64; 3],
-    origin: [f64; 3],
-    mode: &str,
-    normals: bool,
-    max_error: Option<(f64, String)>,
+    made_with: SettingsArgs,
 ) -> PyResult<PathBuf> {
-    let mut manifest = Manifest::new(
-        grid,
-        &params(level, spacing, origin, mode, normals, max_error)?,
-    );
+    let mut manifest = Manifest::new(grid, &settings(made_with)?);
     manifest.shards = records
         .into_iter()
         .map(|(file, cubes, vertices, triangles)| ShardEntry {

@@ -253,7 +253,8 @@ fn check_refuses_broken_shares() {
     let share = share(&vol, &Params::new(20.0), [3..20, 5..30, 2..17]);
     assert!(share.keys.len() > 100);
     assert_eq!(share.check(), Ok(()));
-    let broken: [(&str, fn(&mut BlockMesh)); 5] = [
+    type Damage = fn(&mut BlockMesh);
+    let broken: [(&str, Damage); 5] = [
         ("differ in length", |b| {
             b.positions.pop();
         }),

@@ -93,23 +93,22 @@ def _mesh(block, halos, at, grid, cubes, options):
 
 
 def _native_settings(options):
-    """The settings as the native shard writer takes them (level, spacing, … as keywords)."""
+    """The settings as the native shard writer takes them: one tuple, in extract_block's order."""
     from . import _bound
 
-    return dict(level=options["level"], spacing=options["spacing"], origin=options["origin"],
-                mode=options["mode"], normals=bool(options["normals"]),
-                max_error=_bound(options["max_error"], options["error_units"]))
+    return (options["level"], options["spacing"], options["origin"], options["mode"],
+            bool(options["normals"]), _bound(options["max_error"], options["error_units"]))
 
 
 def _shard(block, halos, at, grid, cubes, options, directory):
     """Meshes one block and writes it as a shard; returns only the manifest's small record, so
     the worker keeps no mesh."""
     share = _mesh(block, halos, at, grid, cubes, options)
-    return _native.write_shard(share._share, directory, cubes, **_native_settings(options))
+    return _native.write_shard(share._share, directory, cubes, _native_settings(options))
 
 
 def _manifest(directory, grid, options, *records):
-    return str(_native.write_manifest(directory, grid, list(records), **_native_settings(options)))
+    return str(_native.write_manifest(directory, grid, list(records), _native_settings(options)))
 
 
 def _merge(*shares):
