@@ -13,7 +13,7 @@
 
 use crate::scratch::{Scratch, WORD_PLANES};
 use crate::tables::{Entry, NO_EAR, grey_edge};
-use crate::vertex::{Field, edge_crossing};
+use crate::vertex::{Field, sample_crossing};
 
 mod bound;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
@@ -216,26 +216,33 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     ) -> Result<(), Error> {
         let [nx, ny, _] = self.grid.dims;
         let field = self.field(src, n, n);
+        let samples = src.slice(n);
         let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
+        let [px, py, pz] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
             let row = grid.row(n, y);
+            let values = &samples[y * nx..][..nx];
             let (lo, hi) = grid.span(grid.slice_row(n, y));
-            let [px, py, pz] = grid.offset.map(|o| o & 1);
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
+            let ids = xbase + y * nx;
             for_each_differing(row, &row[1..], lo, hi, |x| {
-                let id = out.edge_vertex(grid, params, [x, y, n], 0, x_grey, &field, sink)?;
-                out.ids[xbase + y * nx + x] = id;
+                let ends = (values[x], values[x + 1]);
+                let id = out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, &field, sink)?;
+                out.ids[ids + x] = id;
                 Ok(())
             })?;
             if y + 1 < ny {
                 let next = grid.row(n, y + 1);
+                let next_values = &samples[(y + 1) * nx..][..nx];
                 let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
+                let ids = ybase + y * nx;
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
-                    let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
-                    out.ids[ybase + y * nx + x] = id;
+                    let ends = (values[x], next_values[x]);
+                    let id = out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, &field, sink)?;
+                out.ids[ids + x] = id;
                     Ok(())
                 })?;
             }
@@ -252,16 +259,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     ) -> Result<(), Error> {
         let [nx, ny, _] = self.grid.dims;
         let field = self.field(src, k, k + 1);
+        let (lower, upper) = (src.slice(k), src.slice(k + 1));
         let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
             let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
+            let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
             let (start, end) = grid.union_span(&[(y, k), (y, k + 1)]);
+            let ids = zbase + y * nx;
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
-                let id = out.edge_vertex(grid, params, [x, y, k], 2, grey, &field, sink)?;
-                out.ids[zbase + y * nx + x] = id;
+                let ends = (lower[x], upper[x]);
+                let id = out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, &field, sink)?;
+                out.ids[ids + x] = id;
                 Ok(())
             })?;
         }
@@ -373,28 +384,30 @@ const GREYS: [[u8; 3]; 8] = {
 };
 
 impl Out<'_> {
-    /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number.
+    /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number. The
+    /// axis is a constant so each pass gets its own copy with the axis tests folded away; the
+    /// caller reads the edge's two samples straight from its rows.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn edge_vertex<T: Scalar>(
+    #[inline(always)]
+    fn edge_vertex<T: Scalar, const AXIS: usize>(
         &mut self,
         grid: &Grid<'_>,
         params: &Params,
         p: [usize; 3],
-        axis: usize,
         grey: bool,
+        (a, b): (T, T),
         field: &Field<'_, T>,
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
         let mut decision = if grey {
-            grid.decide(p, axis)
+            grid.decide::<AXIS>(p)
         } else {
             Decision::Keep
         };
         let mut bounded = false;
         if decision == Decision::Merge
             && let Some(bound) = params.max_error
-            && !grid.within_bound(p, axis, bound, field, params)
+            && !grid.within_bound(p, AXIS, bound, field, params)
         {
             decision = Decision::Blocked;
             bounded = true;
@@ -416,22 +429,23 @@ impl Out<'_> {
         self.next_id += 1;
         if self.emit {
             self.stats.vertices += u64::from(counted);
-            let t = edge_crossing(field, p, axis, params.iso);
+            let t = sample_crossing(a, b, params.iso);
             let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
             let pos: [f32; 3] = core::array::from_fn(|d| {
-                let c = global[d] as f64 + if d == axis { t } else { 0.0 };
+                let c = global[d] as f64 + if d == AXIS { t } else { 0.0 };
                 (params.origin[d] + c * params.spacing[d]) as f32
             });
             let normal = params
                 .normals
-                .then(|| field.normal(p, axis, t, grid.is_filled(p)));
-            sink.edge_vertex(global, axis, pos, normal);
+                .then(|| field.normal(p, AXIS, t, grid.is_filled(p)));
+            sink.edge_vertex(global, AXIS, pos, normal);
         }
         Ok(id)
     }
 }
 
 impl Grid<'_> {
+    #[inline(always)]
     fn row(&self, z: usize, y: usize) -> &[u8] {
         let [nx, ny, _] = self.dims;
         &self.filled[(z % 4) * nx * ny + y * nx..][..nx]
@@ -444,6 +458,7 @@ impl Grid<'_> {
         p[0] >= x.0 && p[0] < x.1 && p[1] >= y.0 && p[1] < y.1 && p[2] >= z.0 && p[2] < z.1
     }
 
+    #[inline(always)]
     fn is_filled(&self, p: [usize; 3]) -> bool {
         self.row(p[2], p[1])[p[0]] == 1
     }
@@ -538,6 +553,7 @@ impl Grid<'_> {
         }
     }
 
+    #[inline(always)]
     fn case_at(&self, i: usize, j: usize, k: usize) -> u8 {
         let [nx, ny, _] = self.dims;
         self.cases[(k % 3) * nx * ny + j * nx + i]
@@ -546,6 +562,7 @@ impl Grid<'_> {
     /// The four cubes around the edge from `p` along `axis`, as `(i, j, k)`, if it is interior:
     /// the lower two then the upper two along the third axis, each pair ordered along the
     /// remaining one.
+    #[inline(always)]
     fn cubes_around(&self, p: [usize; 3], axis: usize) -> Option<[(usize, usize, usize); 4]> {
         let [l, m, n] = p;
         let [nx, ny, nz] = self.dims;
@@ -564,13 +581,16 @@ impl Grid<'_> {
     }
 
     /// The parity class of a cube of these samples, which follows its global indices.
+    #[inline(always)]
     fn class_of(&self, (i, j, k): (usize, usize, usize)) -> usize {
         let [ox, oy, oz] = self.offset;
         ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2
     }
 
-    /// Step 4's decision for the occupied grey edge from `p` along `axis` (SPEC §5).
-    fn decide(&self, p: [usize; 3], axis: usize) -> Decision {
+    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5).
+    #[inline(always)]
+    fn decide<const AXIS: usize>(&self, p: [usize; 3]) -> Decision {
+        let axis = AXIS;
         if self.mode == Mode::Steps123 {
             return Decision::Keep;
         }
@@ -602,6 +622,7 @@ impl Grid<'_> {
     /// and their quads lie (wholly or in part) in the plane `z = n` with different diagonals:
     /// coplanar triangles overlap. Found by the self-intersection tests on real MRI data; the
     /// stricter test costs a few triangles (the knot: 10,520 instead of 10,516).
+    #[inline(always)]
     fn pinch(&self, p: [usize; 3], axis: usize) -> bool {
         let centre = self.is_filled(p);
         // Face planes as pairs of axes spanning them.

@@ -27,7 +27,14 @@ pub(crate) fn edge_crossing<T: Scalar>(
 ) -> f64 {
     let mut q = p;
     q[axis] += 1;
-    let (a, b) = (field.value(p), field.value(q));
+    let s = |p: [usize; 3]| field.slice(p[2])[p[0] + field.dims[0] * p[1]];
+    sample_crossing(s(p), s(q), iso)
+}
+
+/// Where the surface crosses between the samples `a` and `b` of an edge; the middle at a NaN end.
+#[inline(always)]
+pub(crate) fn sample_crossing<T: Scalar>(a: T, b: T, iso: f64) -> f64 {
+    let (a, b) = (a.to_f64(), b.to_f64());
     if a.is_nan() || b.is_nan() {
         0.5
     } else {
@@ -48,11 +55,6 @@ impl<T: Scalar> Field<'_, T> {
     #[inline]
     fn slice(&self, z: usize) -> &[T] {
         self.slices[z - self.first].expect("the sweep keeps the slices it reads")
-    }
-
-    #[inline]
-    pub fn value(&self, p: [usize; 3]) -> f64 {
-        self.slice(p[2])[p[0] + self.dims[0] * p[1]].to_f64()
     }
 
     /// Central differences inside, one-sided at the border, divided by spacing. Each axis
