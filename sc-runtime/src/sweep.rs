@@ -59,6 +59,9 @@ struct Grid<'s> {
     /// (local indices); everything, except for a block, whose halo is only read.
     own_cubes: [(usize, usize); 3],
     own_edges: [(usize, usize); 3],
+    /// Whether `own_edges` leaves any edge out (a block's sweep): otherwise the per-vertex
+    /// ownership test is skipped.
+    restricted: bool,
 }
 
 /// Vertex numbering and counts.
@@ -97,6 +100,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 offset: [0; 3],
                 own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
                 own_edges: dims.map(|n| (0, n)),
+                restricted: false,
             },
             out: Out {
                 ids,
@@ -118,6 +122,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let dims = self.grid.dims;
         self.grid.offset = offset;
         self.grid.own_cubes = own;
+        self.grid.restricted = true;
         self.grid.own_edges = core::array::from_fn(|d| {
             (
                 own[d].0,
@@ -208,6 +213,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Vertices on the x- and y-edges of plane `n`, row by row.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn plane_vertices(
         &mut self,
         n: usize,
@@ -229,7 +236,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let ids = xbase + y * nx;
             for_each_differing(row, &row[1..], lo, hi, |x| {
                 let ends = (values[x], values[x + 1]);
-                let id = out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, &field, sink)?;
+                let id =
+                    out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, &field, sink)?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -241,8 +249,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
                     let ends = (values[x], next_values[x]);
-                    let id = out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, &field, sink)?;
-                out.ids[ids + x] = id;
+                    let id =
+                        out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, &field, sink)?;
+                    out.ids[ids + x] = id;
                     Ok(())
                 })?;
             }
@@ -251,6 +260,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Vertices on the z-edges of layer `k`, row by row.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn z_vertices(
         &mut self,
         k: usize,
@@ -271,7 +282,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
                 let ends = (lower[x], upper[x]);
-                let id = out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, &field, sink)?;
+                let id =
+                    out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, &field, sink)?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -280,6 +292,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Steps 3 and 4: each cube's table triangles, with the ears of merged grey edges replaced.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn triangles(&mut self, k: usize, sink: &mut impl Sink) {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
@@ -343,7 +357,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                     let n = kept.trailing_zeros() as usize;
                     kept &= kept - 1;
                     stats.triangles += 1;
-                    sink.cube_triangle([i + ox, j + oy, k + oz], entry.tris[n].map(id));
+                    let [a, b, c] = entry.tris[n];
+                    sink.cube_triangle([i + ox, j + oy, k + oz], [id(a), id(b), id(c)]);
                 }
             }
         }
@@ -432,7 +447,8 @@ impl Out<'_> {
             let t = sample_crossing(a, b, params.iso);
             let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
             let pos: [f32; 3] = core::array::from_fn(|d| {
-                let c = global[d] as f64 + if d == AXIS { t } else { 0.0 };
+                // Through i64: one instruction, where usize to f64 takes several; exact below 2^53.
+                let c = global[d] as i64 as f64 + if d == AXIS { t } else { 0.0 };
                 (params.origin[d] + c * params.spacing[d]) as f32
             });
             let normal = params
@@ -455,7 +471,8 @@ impl Grid<'_> {
     #[inline(always)]
     fn owns_edge(&self, p: [usize; 3]) -> bool {
         let [x, y, z] = self.own_edges;
-        p[0] >= x.0 && p[0] < x.1 && p[1] >= y.0 && p[1] < y.1 && p[2] >= z.0 && p[2] < z.1
+        !self.restricted
+            || p[0] >= x.0 && p[0] < x.1 && p[1] >= y.0 && p[1] < y.1 && p[2] >= z.0 && p[2] < z.1
     }
 
     #[inline(always)]
@@ -484,6 +501,8 @@ impl Grid<'_> {
     }
 
     /// Step 1's classification of slice `z`, and each row's span of x-edge changes.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn classify<T: Scalar>(&mut self, z: usize, slice: &[T], threshold: T::Threshold) {
         let [nx, ny, _] = self.dims;
         let slot = (z % 4) * nx * ny;
@@ -525,6 +544,8 @@ impl Grid<'_> {
     }
 
     /// Cube cases of layer `k`, over each cube row's span of non-trivial cubes.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn compute_cases(&mut self, k: usize) {
         let [nx, ny, _] = self.dims;
         for j in 0..ny - 1 {
