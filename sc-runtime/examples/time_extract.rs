@@ -41,7 +41,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "paper" => Mode::Paper,
             other => return Err(format!("unknown mode {other}").into()),
         };
-        let ((ms, min), triangles, checksum) = match dtype.as_str() {
+        let Timing {
+            median,
+            fastest,
+            triangles,
+            checksum,
+        } = match dtype.as_str() {
             "u8" => time(&raw, dims, mode, &options)?,
             "i16" => time(&cast(&raw, i16::from_le_bytes), dims, mode, &options)?,
             "u16" => time(&cast(&raw, u16::from_le_bytes), dims, mode, &options)?,
@@ -49,11 +54,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             other => return Err(format!("unknown dtype {other}").into()),
         };
         println!(
-            "{mode:?}: {ms:.3} ms (median of {}; fastest {min:.3} ms), {triangles} triangles, mesh checksum {checksum:016x}",
+            "{mode:?}: {median:.3} ms (median of {}; fastest {fastest:.3} ms), {triangles} triangles, mesh checksum {checksum:016x}",
             options.runs
         );
     }
     Ok(())
+}
+
+struct Timing {
+    median: f64,
+    fastest: f64,
+    triangles: usize,
+    checksum: u64,
 }
 
 struct Options {
@@ -68,7 +80,7 @@ fn time<T: Scalar>(
     dims: [usize; 3],
     mode: Mode,
     options: &Options,
-) -> Result<((f64, f64), usize, u64), Box<dyn std::error::Error>> {
+) -> Result<Timing, Box<dyn std::error::Error>> {
     let vol = Volume::new(data, dims)?;
     let params = Params {
         mode,
@@ -85,8 +97,12 @@ fn time<T: Scalar>(
     }
     times.sort_by(f64::total_cmp);
     let mesh = mesh.expect("at least one run");
-    let (median, min) = (times[times.len() / 2], times[0]);
-    Ok(((median, min), mesh.triangles.len(), checksum(&mesh)))
+    Ok(Timing {
+        median: times[times.len() / 2],
+        fastest: times[0],
+        triangles: mesh.triangles.len(),
+        checksum: checksum(&mesh),
+    })
 }
 
 /// FNV-1a over the mesh's bytes: variants of the sweep must leave it unchanged.

@@ -11,6 +11,14 @@ pub trait Scalar: Copy + Send + Sync + 'static {
     fn filled(self, t: Self::Threshold) -> bool;
     /// The sample as `f64`, for interpolation and gradients.
     fn to_f64(self) -> f64;
+    /// Step 1 over a row: `out[i]` is 1 where `row[i]` is filled, else 0. A type may override
+    /// it to take per-row decisions out of the loop, so that the loop vectorises.
+    #[inline]
+    fn classify_row(row: &[Self], t: Self::Threshold, out: &mut [u8]) {
+        for (o, v) in out.iter_mut().zip(row) {
+            *o = u8::from(v.filled(t));
+        }
+    }
 }
 
 macro_rules! int_scalar {
@@ -32,6 +40,17 @@ macro_rules! int_scalar {
             #[inline]
             fn to_f64(self) -> f64 {
                 self as f64
+            }
+            #[inline]
+            fn classify_row(row: &[$t], t: Option<$t>, out: &mut [u8]) {
+                match t {
+                    Some(t) => {
+                        for (o, &v) in out.iter_mut().zip(row) {
+                            *o = u8::from(v >= t);
+                        }
+                    }
+                    None => out.fill(0),
+                }
             }
         }
     )*};

@@ -244,7 +244,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             if y + 1 < ny {
                 let next = grid.row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
-                let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
+                let (start, end) = grid.union_span([(y, n), (y + 1, n)]);
                 let ids = ybase + y * nx;
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
@@ -277,7 +277,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         for y in 0..ny {
             let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
-            let (start, end) = grid.union_span(&[(y, k), (y, k + 1)]);
+            let (start, end) = grid.union_span([(y, k), (y, k + 1)]);
             let ids = zbase + y * nx;
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
@@ -508,9 +508,7 @@ impl Grid<'_> {
         let slot = (z % 4) * nx * ny;
         for y in 0..ny {
             let row = &mut self.filled[slot + y * nx..][..nx];
-            for (o, v) in row.iter_mut().zip(&slice[y * nx..][..nx]) {
-                *o = u8::from(v.filled(threshold));
-            }
+            T::classify_row(&slice[y * nx..][..nx], threshold, row);
             let span = match first_differing(row, row[0]) {
                 None => (nx - 1, 0),
                 Some(first) => (
@@ -524,13 +522,14 @@ impl Grid<'_> {
 
     /// The x range `start..end` outside which the rows `(y, z)` agree with each other and are
     /// constant along x.
-    fn union_span(&self, rows: &[(usize, usize)]) -> (usize, usize) {
+    #[inline(always)]
+    fn union_span<const N: usize>(&self, rows: [(usize, usize); N]) -> (usize, usize) {
         let nx = self.dims[0];
         let first = self.row(rows[0].1, rows[0].0);
         let (f0, f1) = (first[0], first[nx - 1]);
         let (mut lo, mut hi) = (nx - 1, 0);
         let (mut same0, mut same1) = (true, true);
-        for &(y, z) in rows {
+        for (y, z) in rows {
             let (l, h) = self.span(self.slice_row(z, y));
             lo = lo.min(l);
             hi = hi.max(h);
@@ -551,25 +550,26 @@ impl Grid<'_> {
         for j in 0..ny - 1 {
             let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)];
             // Points `start..end` may vary, so cubes `start..end - 1` may be non-trivial.
-            let (start, end) = self.union_span(&rows);
+            let (start, end) = self.union_span(rows);
             let span = (start, (end.max(1) - 1).max(start));
             self.set_span(self.case_row(k, j), span);
             let (lo, hi) = span;
             if lo >= hi {
                 continue;
             }
-            let [r0, r1, r2, r3] =
-                rows.map(|(y, z)| &self.filled[(z % 4) * nx * ny + y * nx..][lo..=hi]);
-            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..hi - lo];
-            for (i, o) in out.iter_mut().enumerate() {
-                *o = r0[i]
-                    | r0[i + 1] << 1
-                    | r1[i] << 2
-                    | r1[i + 1] << 3
-                    | r2[i] << 4
-                    | r2[i + 1] << 5
-                    | r3[i] << 6
-                    | r3[i + 1] << 7;
+            // Row by row, each a zip of plain slices, so that the loops vectorise.
+            let len = hi - lo;
+            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..len];
+            for (n, (y, z)) in rows.into_iter().enumerate() {
+                let r = &self.filled[(z % 4) * nx * ny + y * nx + lo..][..=len];
+                let pairs = r.iter().zip(&r[1..]).map(|(a, b)| a | b << 1);
+                if n == 0 {
+                    out.iter_mut().zip(pairs).for_each(|(o, p)| *o = p);
+                } else {
+                    out.iter_mut()
+                        .zip(pairs)
+                        .for_each(|(o, p)| *o |= p << (2 * n));
+                }
             }
         }
     }
