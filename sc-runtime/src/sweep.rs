@@ -81,6 +81,8 @@ pub(crate) struct Sweep<'s, T: Scalar> {
     threshold: T::Threshold,
     /// The layer `start` prepared: where this sweep's output began.
     first_layer: usize,
+    /// The gradient's reciprocal steps, computed once.
+    steps: [[f64; 2]; 3],
 }
 
 impl<'s, T: Scalar> Sweep<'s, T> {
@@ -111,6 +113,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             params: *params,
             threshold: T::threshold(params.iso),
             first_layer: 0,
+            steps: Field::<T>::steps(params.spacing),
         }
     }
 
@@ -200,13 +203,14 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     fn field<'v>(&self, src: &'v impl Slices<T>, z_lo: usize, z_hi: usize) -> Field<'v, T> {
         let nz = self.grid.dims[2];
         let first = z_lo.saturating_sub(1);
-        let mut slices = [None; 4];
+        // Slices past the grid stay empty: reading one fails like an index past the data.
+        let mut slices: [&[T]; 4] = [&[]; 4];
         for (i, z) in (first..=(z_hi + 1).min(nz - 1)).enumerate() {
-            slices[i] = Some(src.slice(z));
+            slices[i] = src.slice(z);
         }
         Field {
             dims: self.grid.dims,
-            spacing: self.params.spacing,
+            steps: self.steps,
             slices,
             first,
         }
