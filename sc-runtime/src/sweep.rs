@@ -750,13 +750,15 @@ fn for_each_differing(
     Ok(())
 }
 
-/// The first index whose byte differs from `v`, comparing 16 bytes at a time.
+/// The first index whose byte differs from `v`, comparing eight bytes at a time.
 fn first_differing(row: &[u8], v: u8) -> Option<usize> {
-    let chunks = row.chunks_exact(16);
+    let splat = u64::from_ne_bytes([v; 8]);
+    let chunks = row.chunks_exact(8);
     let tail = chunks.remainder();
     for (c, chunk) in chunks.enumerate() {
-        if chunk != [v; 16] {
-            return chunk.iter().position(|&b| b != v).map(|i| c * 16 + i);
+        let d = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ splat;
+        if d != 0 {
+            return Some(c * 8 + d.trailing_zeros() as usize / 8);
         }
     }
     tail.iter()
@@ -764,14 +766,16 @@ fn first_differing(row: &[u8], v: u8) -> Option<usize> {
         .map(|i| row.len() - tail.len() + i)
 }
 
-/// The last index whose byte differs from `v`, comparing 16 bytes at a time.
+/// The last index whose byte differs from `v`, comparing eight bytes at a time.
 fn last_differing(row: &[u8], v: u8) -> Option<usize> {
-    let chunks = row.rchunks_exact(16);
+    let splat = u64::from_ne_bytes([v; 8]);
+    let chunks = row.rchunks_exact(8);
     let head = chunks.remainder();
     for (c, chunk) in chunks.enumerate() {
-        if chunk != [v; 16] {
-            let start = row.len() - (c + 1) * 16;
-            return chunk.iter().rposition(|&b| b != v).map(|i| start + i);
+        let d = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ splat;
+        if d != 0 {
+            let start = row.len() - (c + 1) * 8;
+            return Some(start + (63 - d.leading_zeros() as usize) / 8);
         }
     }
     head.iter().rposition(|&b| b != v)
