@@ -302,21 +302,25 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
         let (lo, hi) = (k % 2, (k + 1) % 2);
-        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`.
-        let edge_at: [usize; 12] = core::array::from_fn(|e| {
+        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`;
+        // sixteen entries, so that an edge number masked with 15 needs no bounds check.
+        let edge_at: [usize; 16] = core::array::from_fn(|e| {
             let r = e % 4;
             let (a, b) = (r & 1, r >> 1);
             match e / 4 {
                 0 => [lo, hi][b] * 2 * nxy + a * nx,
                 1 => [lo, hi][b] * 2 * nxy + nxy + a,
-                _ => 4 * nxy + a + b * nx,
+                2 => 4 * nxy + a + b * nx,
+                _ => 0,
             }
         });
         // Where each class's three grey-edge ids live, relative to the cube's `i + nx * j`.
         let grey_at: [[usize; 3]; 8] = GREYS.map(|g| g.map(|e| edge_at[usize::from(e)]));
         let grid = &self.grid;
         let ids = &*self.out.ids;
-        let stats = &mut self.out.stats;
+        // Counted in locals, added to the stats once: stores to the stats on every cube could
+        // not be moved past the loop's bounds checks.
+        let (mut t13, mut triangles) = (0u64, 0u64);
         let merging = grid.mode != Mode::Steps123;
         let entries = grid.entries;
         let [ox, oy, oz] = grid.offset;
@@ -326,15 +330,18 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let cases = &grid.cases[(k % 3) * nxy + j * nx..][..nx];
             let class_jk = ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
             let (start, end) = (start.max(x_lo), end.min(x_hi));
-            for (i, &case) in cases.iter().enumerate().take(end).skip(start) {
+            if start >= end {
+                continue;
+            }
+            for (i, &case) in (start..).zip(&cases[start..end]) {
                 if case == 0 || case == 255 {
                     continue;
                 }
                 let class = ((i + ox) & 1) | class_jk;
                 let entry = &entries[class * 256 + usize::from(case)];
-                stats.t13 += u64::from(entry.count);
+                t13 += u64::from(entry.count);
                 let at = i + nx * j;
-                let id = |e: u8| ids[edge_at[usize::from(e)] + at];
+                let id = |e: u8| ids[edge_at[usize::from(e & 15)] + at];
                 // A merged grey edge's ear is dropped; the pair's owner emits the merged
                 // triangle in its place (its partner emits nothing). Masks rather than branches:
                 // which greys merged is data, and data-dependent branches mispredict.
@@ -351,7 +358,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                     while owned != 0 {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
-                        stats.triangles += 1;
+                        triangles += 1;
                         let t = grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at);
                         sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
@@ -360,12 +367,14 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 while kept != 0 {
                     let n = kept.trailing_zeros() as usize;
                     kept &= kept - 1;
-                    stats.triangles += 1;
+                    triangles += 1;
                     let [a, b, c] = entry.tris[n];
                     sink.cube_triangle([i + ox, j + oy, k + oz], [id(a), id(b), id(c)]);
                 }
             }
         }
+        self.out.stats.t13 += t13;
+        self.out.stats.triangles += triangles;
     }
 }
 
@@ -625,11 +634,13 @@ impl Grid<'_> {
         if self.mode == Mode::Paper {
             return Decision::Merge;
         }
-        let mergeable = cubes.iter().all(|&(i, j, k)| {
+        // All four bits ANDed, not a short-circuit: one branch on the result instead of four
+        // on the data.
+        let mergeable = cubes.iter().fold(1u8, |all, &(i, j, k)| {
             let class = self.class_of((i, j, k));
-            self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis & 1 == 1
+            all & self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis
         });
-        if mergeable && !self.pinch(p, axis) {
+        if mergeable & 1 == 1 && !self.pinch(p, axis) {
             Decision::Merge
         } else {
             Decision::Blocked
@@ -695,7 +706,7 @@ impl Grid<'_> {
         [i, j, k]: [usize; 3],
         axis: usize,
         entry: &Entry,
-        edge_at: &[usize; 12],
+        edge_at: &[usize; 16],
     ) -> [u32; 3] {
         let [ox, oy, oz] = self.offset;
         let along_y = axis == 0 || (axis == 2 && (k + oz).is_multiple_of(2));
@@ -707,8 +718,8 @@ impl Grid<'_> {
         let outer = |e: &Entry, at: usize| {
             let [b, _, f] = e.tris[usize::from(e.ears[axis])];
             (
-                ids[edge_at[usize::from(b)] + at],
-                ids[edge_at[usize::from(f)] + at],
+                ids[edge_at[usize::from(b & 15)] + at],
+                ids[edge_at[usize::from(f & 15)] + at],
             )
         };
         let (ba, fa) = outer(entry, i + nx * j);
