@@ -60,6 +60,21 @@ int_scalar!(u8, i8, u16, i16, u32, i32);
 impl Scalar for f32 {
     /// The smallest `f32` at or above `iso`, so `v >= t` in `f32` is exactly `v as f64 >= iso`.
     type Threshold = f32;
+    /// In blocks of sixteen: LLVM does not vectorise the plain loop, whose compare results are
+    /// four times the width of its output bytes; this form it does.
+    #[inline]
+    fn classify_row(row: &[f32], t: f32, out: &mut [u8]) {
+        let mut blocks = out.chunks_exact_mut(16);
+        let mut rows = row.chunks_exact(16);
+        for (o, v) in (&mut blocks).zip(&mut rows) {
+            for (o, &v) in o.iter_mut().zip(v) {
+                *o = u8::from(v >= t);
+            }
+        }
+        for (o, &v) in blocks.into_remainder().iter_mut().zip(rows.remainder()) {
+            *o = u8::from(v >= t);
+        }
+    }
     #[inline]
     fn threshold(iso: f64) -> f32 {
         let t = iso as f32;
