@@ -18,6 +18,9 @@ use crate::vertex::{Field, sample_crossing};
 mod bound;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
 
+/// The top bit of a classified row's span words: its first and last bytes (see `Grid::ends`).
+const END_BIT: u32 = 1 << 31;
+
 /// Vertex id of a grey edge merged away by Step 4.
 const MERGED: u32 = u32::MAX;
 
@@ -503,8 +506,17 @@ impl Grid<'_> {
 
     fn span(&self, row: usize) -> (usize, usize) {
         (
-            self.spans[2 * row] as usize,
-            self.spans[2 * row + 1] as usize,
+            (self.spans[2 * row] & !END_BIT) as usize,
+            (self.spans[2 * row + 1] & !END_BIT) as usize,
+        )
+    }
+
+    /// A classified row's first and last bytes, kept in its span's top bits: [`Grid::union_span`]
+    /// then reads only the compact spans, not two cache lines of each row.
+    fn ends(&self, row: usize) -> (u32, u32) {
+        (
+            self.spans[2 * row] & END_BIT,
+            self.spans[2 * row + 1] & END_BIT,
         )
     }
 
@@ -529,7 +541,11 @@ impl Grid<'_> {
                     last_differing(row, row[nx - 1]).map_or(0, |l| l + 1),
                 ),
             };
-            self.set_span(self.slice_row(z, y), span);
+            let (first, last) = (u32::from(row[0]) << 31, u32::from(row[nx - 1]) << 31);
+            let r = self.slice_row(z, y);
+            self.set_span(r, span);
+            self.spans[2 * r] |= first;
+            self.spans[2 * r + 1] |= last;
         }
     }
 
@@ -538,17 +554,17 @@ impl Grid<'_> {
     #[inline(always)]
     fn union_span<const N: usize>(&self, rows: [(usize, usize); N]) -> (usize, usize) {
         let nx = self.dims[0];
-        let first = self.row(rows[0].1, rows[0].0);
-        let (f0, f1) = (first[0], first[nx - 1]);
+        let (f0, f1) = self.ends(self.slice_row(rows[0].1, rows[0].0));
         let (mut lo, mut hi) = (nx - 1, 0);
         let (mut same0, mut same1) = (true, true);
         for (y, z) in rows {
-            let (l, h) = self.span(self.slice_row(z, y));
+            let row = self.slice_row(z, y);
+            let (l, h) = self.span(row);
             lo = lo.min(l);
             hi = hi.max(h);
-            let r = self.row(z, y);
-            same0 &= r[0] == f0;
-            same1 &= r[nx - 1] == f1;
+            let (e0, e1) = self.ends(row);
+            same0 &= e0 == f0;
+            same1 &= e1 == f1;
         }
         let start = if same0 { lo } else { 0 };
         let end = if same1 { hi + 1 } else { nx };
