@@ -65,7 +65,7 @@ pub fn extract_par<T: Scalar>(
         .as_ref()
         .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     // A few chunks per thread balance uneven surfaces without much re-reading at the seams.
-    let chunks = (workers * 4).min(layers.div_ceil(MIN_CHUNK_LAYERS)).max(1);
+    let chunks = (workers * 2).min(layers.div_ceil(MIN_CHUNK_LAYERS)).max(1);
     let bounds: Vec<(usize, usize)> = (0..chunks)
         .map(|c| (c * layers / chunks, (c + 1) * layers / chunks))
         .collect();
