@@ -3,21 +3,26 @@
 
 Runs `cargo bench -p sc-runtime --bench extract` (criterion), then times FlyingEdges on each
 volume the benchmarks used (the built-in 256³ volumes, rebuilt here sample for sample, and the
-SC_DATA_DIR volumes), and prints the README's tables: times, ratios and triangle counts.
+SC_DATA_DIR volumes at each suggested iso value), and prints the README's speed tables: times,
+ratios, Step 4's and normals' costs, two-thread speed-ups, and the whole `skelclimb extract`
+process against its extraction.
 
     pip install vtk numpy
-    SC_DATA_DIR=../shared/data python3 bench/compare.py [--skip-cargo] [--repeat 10]
+    SC_DATA_DIR=../shared/data python3 bench/compare.py [--skip-cargo] [--repeat 9]
 
-FlyingEdges runs with normals, gradients and scalars off, like the benchmarks (normals off), on
-one thread: the times in the table are milliseconds, single-threaded unless the column says
-otherwise.
+With SC_DATA_DIR set, bench/derive_volumes.py first derives larger u8, i16 and f32 volumes from
+it into target/bench-data, and both folders are benchmarked.
+
+Times are milliseconds, medians. FlyingEdges runs with gradients and scalars off, normals off
+unless the column says otherwise, on one thread unless the column says otherwise.
 """
-import argparse, glob, json, os, platform, subprocess, sys, time
+import argparse, glob, json, os, platform, subprocess, sys, tempfile, time
 import numpy as np
 import vtk
 from vtk.util import numpy_support
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DERIVED = os.path.join(ROOT, "target", "bench-data")
 
 
 def cells(n, lo, hi):
@@ -57,7 +62,23 @@ def noise(n):
 
 
 BUILTIN = {"sphere-256": (sphere, 0.0), "knot-256": (knot, 0.9), "noise-256": (noise, 0.0)}
-DTYPES = {"u8": np.uint8, "i16": np.int16, "u16": np.uint16}
+DTYPES = {"u8": "<u1", "i16": "<i2", "u16": "<u2", "f32": "<f4"}
+
+
+def data_dirs():
+    return [d for d in os.environ.get("SC_DATA_DIR", "").split(os.pathsep) if d]
+
+
+def raw_volume(name):
+    """The raw file, its JSON description and the array (z, y, x) of a named data volume."""
+    for d in data_dirs():
+        meta_path = os.path.join(d, name, name + ".json")
+        if os.path.exists(meta_path):
+            meta = json.load(open(meta_path))
+            nx, ny, nz = meta["dims"]
+            raw = os.path.join(d, name, name + ".raw")
+            return raw, meta, np.fromfile(raw, dtype=DTYPES[meta["dtype"]]).reshape(nz, ny, nx)
+    raise SystemExit(f"{name}: not found in SC_DATA_DIR")
 
 
 def volume(group):
@@ -66,13 +87,10 @@ def volume(group):
         f, iso = BUILTIN[group]
         return f(256).astype(np.float32), iso
     name, iso = group.rsplit("@", 1)
-    meta = json.load(open(os.path.join(os.environ["SC_DATA_DIR"], name, name + ".json")))
-    nx, ny, nz = meta["dims"]
-    raw = np.fromfile(os.path.join(os.environ["SC_DATA_DIR"], name, name + ".raw"), dtype=DTYPES[meta["dtype"]])
-    return raw.reshape(nz, ny, nx), float(iso)
+    return raw_volume(name)[2], float(iso)
 
 
-def flying_edges(arr, iso, threads, repeat):
+def flying_edges(arr, iso, threads, repeat, normals=False):
     img = vtk.vtkImageData()
     img.SetDimensions(arr.shape[2], arr.shape[1], arr.shape[0])
     img.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(arr).ravel(), deep=True))
@@ -80,7 +98,7 @@ def flying_edges(arr, iso, threads, repeat):
     fe = vtk.vtkFlyingEdges3D()
     fe.SetInputData(img)
     fe.SetValue(0, iso)
-    fe.SetComputeNormals(False)
+    fe.SetComputeNormals(normals)
     fe.SetComputeGradients(False)
     fe.SetComputeScalars(False)
     times = []
@@ -100,29 +118,68 @@ def criterion_ms(group, fn, threads):
     return json.load(open(hits[0]))["median"]["point_estimate"] / 1e6
 
 
+def process_times(group, repeat):
+    """The whole `skelclimb extract` (one thread, no normals, binary PLY) against the extraction
+    time it reports, medians of `repeat` runs; None for built-in volumes."""
+    if "@" not in group:
+        return None
+    name, iso = group.rsplit("@", 1)
+    raw = raw_volume(name)[0]
+    exe = os.path.join(ROOT, "target", "release", "skelclimb")
+    whole, extract, tris = [], [], 0
+    with tempfile.TemporaryDirectory() as tmp:
+        out, stats = os.path.join(tmp, "m.ply"), os.path.join(tmp, "s.json")
+        for _ in range(repeat):
+            t = time.perf_counter()
+            subprocess.run([exe, "extract", raw, "--iso", iso, "-o", out, "--threads", "1", "--no-normals",
+                            "-q", "--stats-json", stats], check=True)
+            whole.append(time.perf_counter() - t)
+            j = json.load(open(stats))
+            extract.append(j["seconds"]["extract"])
+            tris = j["result"]["triangles"]
+    return 1000 * sorted(whole)[repeat // 2], 1000 * sorted(extract)[repeat // 2], tris
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--skip-cargo", action="store_true", help="reuse target/criterion results")
-    ap.add_argument("--repeat", type=int, default=10)
+    ap.add_argument("--repeat", type=int, default=9)
     a = ap.parse_args()
+    if data_dirs():
+        if not os.path.isdir(DERIVED):
+            subprocess.run([sys.executable, os.path.join(ROOT, "bench", "derive_volumes.py"), DERIVED], check=True)
+        os.environ["SC_DATA_DIR"] = os.pathsep.join(data_dirs() + [DERIVED])
     if not a.skip_cargo:
         subprocess.run(["cargo", "bench", "-p", "sc-runtime", "--bench", "extract"], cwd=ROOT, check=True)
+    subprocess.run(["cargo", "build", "--quiet", "--release", "-p", "sc-cli"], cwd=ROOT, check=True)
     all_t = os.cpu_count() or 1
     groups = sorted(os.listdir(os.path.join(ROOT, "target", "criterion")))
     groups = [g for g in groups if g in BUILTIN or "@" in g]
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), platform.processor())
     print(f"\nMachine: {cpu}, {all_t} threads; VTK {vtk.vtkVersion.GetVTKVersion()} (SMP backend {vtk.vtkSMPTools().GetBackend()})\n")
-    print("| volume (MC triangles) | Flying Edges | Steps 1–3 | embedded | paper | **embedded / FE** | embedded, all threads | speed-up | Step 4 cost |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(f"| volume (FE triangles) | FE | Steps 1–3 | embedded | paper | **embedded / FE** | Step 4 cost | normals: ours / FE's | FE, {all_t} threads | embedded, {all_t} threads | speed-up: ours / FE's | **embedded / FE, {all_t} threads** |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
     for g in groups:
         arr, iso = volume(g)
         fe1, tris = flying_edges(arr, iso, 1, a.repeat)
-        s1, e1, p1 = (criterion_ms(g, f, 1) for f in ("steps123", "embedded", "paper"))
+        fe_all, _ = flying_edges(arr, iso, all_t, a.repeat)
+        fe_n, _ = flying_edges(arr, iso, 1, a.repeat, normals=True)
+        s1, e1, p1, en = (criterion_ms(g, f, 1) for f in ("steps123", "embedded", "paper", "embedded-normals"))
         e_all = criterion_ms(g, "embedded", all_t)
-        if None in (s1, e1, p1, e_all):
+        if None in (s1, e1, p1, en, e_all):
             print(f"| {g} | missing criterion results |")
             continue
-        print(f"| {g} ({tris:,}) | {fe1:.1f} | {s1:.1f} | {e1:.1f} | {p1:.1f} | **{e1 / fe1:.2f}×** | {e_all:.1f} | {e1 / e_all:.2f}× | {100 * (e1 / s1 - 1):+.0f}% |")
+        rows.append((g, tris))
+        print(f"| {g} ({tris:,}) | {fe1:.1f} | {s1:.1f} | {e1:.1f} | {p1:.1f} | **{e1 / fe1:.2f}×** | {100 * (e1 / s1 - 1):+.0f}% "
+              f"| {100 * (en / e1 - 1):+.0f}% / {100 * (fe_n / fe1 - 1):+.0f}% | {fe_all:.1f} | {e_all:.1f} "
+              f"| {e1 / e_all:.2f}× / {fe1 / fe_all:.2f}× | **{e_all / fe_all:.2f}×** |")
+    print("\n| volume | triangles (embedded) | whole `skelclimb extract` | its extraction | **ratio** |")
+    print("|---|---|---|---|---|")
+    for g, _ in rows:
+        t = process_times(g, a.repeat)
+        if t:
+            print(f"| {g} | {t[2]:,} | {t[0]:.1f} | {t[1]:.1f} | **{t[0] / t[1]:.2f}×** |")
 
 
 if __name__ == "__main__":

@@ -115,7 +115,7 @@ pub fn extract<'py>(
         .into_pyobject(py)
 }
 
-fn run<T: Scalar + Element>(
+pub(crate) fn run<T: Scalar + Element>(
     py: Python<'_>,
     volume: &Bound<'_, PyUntypedArray>,
     dims: [usize; 3],

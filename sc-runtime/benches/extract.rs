@@ -1,9 +1,11 @@
 //! Extraction speed: built-in 256³ volumes and the real volumes of `SC_DATA_DIR`, in each mode,
 //! on one thread and on all threads.
 //!
-//! `SC_DATA_DIR` points at a folder of `<name>/<name>.raw` + `<name>.json` volumes (dims, dtype,
-//! suggested iso values), such as the project's shared data. Without it those benchmarks are
-//! skipped with a notice. `bench/compare.py` runs these and VTK's FlyingEdges in one go.
+//! `SC_DATA_DIR` points at folders (separated by `:`) of `<name>/<name>.raw` + `<name>.json`
+//! volumes (dims, dtype u8/i16/u16/f32, suggested iso values; each is benchmarked at every
+//! suggested value), such as the project's shared data and what `bench/derive_volumes.py` makes
+//! of it. Without it those benchmarks are skipped with a notice. `bench/compare.py` runs these
+//! and VTK's FlyingEdges in one go.
 
 use std::path::Path;
 use std::time::Duration;
@@ -25,21 +27,23 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
         .sample_size(10)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(3));
-    for (mode, mode_name) in MODES {
+    let threads = if all > 1 { vec![1, all] } else { vec![1] };
+    let runs = MODES
+        .iter()
+        .flat_map(|&(mode, name)| threads.iter().map(move |&t| (mode, name, false, t)))
+        // Normals' cost, on one thread, in the mode people use.
+        .chain([(Mode::Embedded, "embedded-normals", true, 1)]);
+    for (mode, mode_name, normals, threads) in runs {
         let params = Params {
             mode,
-            normals: false,
+            normals,
             ..Params::new(iso)
         };
-        for threads in [1, all] {
-            group.bench_with_input(
-                BenchmarkId::new(mode_name, format!("{threads}t")),
-                &threads,
-                |b, &t| {
-                    b.iter(|| extract_par(&vol, &params, t, &|_| {}).expect("extraction succeeds"))
-                },
-            );
-        }
+        group.bench_with_input(
+            BenchmarkId::new(mode_name, format!("{threads}t")),
+            &threads,
+            |b, &t| b.iter(|| extract_par(&vol, &params, t, &|_| {}).expect("extraction succeeds")),
+        );
     }
     group.finish();
 }
@@ -63,12 +67,12 @@ fn synthetic(c: &mut Criterion) {
 }
 
 fn real(c: &mut Criterion) {
-    let Some(dir) = std::env::var_os("SC_DATA_DIR") else {
+    let Some(dirs) = std::env::var_os("SC_DATA_DIR") else {
         eprintln!("SC_DATA_DIR is not set: skipping the real-volume benchmarks");
         return;
     };
-    let mut names: Vec<_> = std::fs::read_dir(&dir)
-        .into_iter()
+    let mut names: Vec<_> = std::env::split_paths(&dirs)
+        .flat_map(std::fs::read_dir)
         .flatten()
         .flatten()
         .map(|e| e.path())
@@ -83,17 +87,15 @@ fn real(c: &mut Criterion) {
         let json = d.join(format!("{stem}.json"));
         match load(&json) {
             Ok((meta, raw)) => {
-                let dims = meta.dims;
-                let name = format!("{stem}@{}", meta.iso);
-                match meta.dtype.as_str() {
-                    "u8" => bench_volume(c, &name, &raw, dims, meta.iso),
-                    "i16" => {
-                        bench_volume(c, &name, &cast(&raw, i16::from_le_bytes), dims, meta.iso)
+                for &iso in &meta.isos {
+                    let (name, dims) = (format!("{stem}@{iso}"), meta.dims);
+                    match meta.dtype.as_str() {
+                        "u8" => bench_volume(c, &name, &raw, dims, iso),
+                        "i16" => bench_volume(c, &name, &cast(&raw, i16::from_le_bytes), dims, iso),
+                        "u16" => bench_volume(c, &name, &cast(&raw, u16::from_le_bytes), dims, iso),
+                        "f32" => bench_volume(c, &name, &cast(&raw, f32::from_le_bytes), dims, iso),
+                        other => eprintln!("{}: dtype {other} not benchmarked", json.display()),
                     }
-                    "u16" => {
-                        bench_volume(c, &name, &cast(&raw, u16::from_le_bytes), dims, meta.iso)
-                    }
-                    other => eprintln!("{}: dtype {other} not benchmarked", json.display()),
                 }
             }
             Err(e) => eprintln!("skipping {}: {e}", json.display()),
@@ -104,10 +106,10 @@ fn real(c: &mut Criterion) {
 struct Meta {
     dims: [usize; 3],
     dtype: String,
-    iso: f64,
+    isos: Vec<f64>,
 }
 
-/// Reads a volume's description (its first suggested iso value) and raw samples.
+/// Reads a volume's description (its suggested iso values) and raw samples.
 fn load(json: &Path) -> Result<(Meta, Vec<u8>), String> {
     let text = std::fs::read_to_string(json).map_err(|e| e.to_string())?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
@@ -118,17 +120,20 @@ fn load(json: &Path) -> Result<(Meta, Vec<u8>), String> {
         .filter_map(|d| d.as_u64())
         .map(|d| d as usize)
         .collect();
-    let iso = v["iso_suggestions"]
+    let isos: Vec<f64> = v["iso_suggestions"]
         .as_object()
-        .and_then(|o| o.values().find_map(|x| x.as_f64()))
-        .ok_or("no iso")?;
+        .map(|o| o.values().filter_map(|x| x.as_f64()).collect())
+        .unwrap_or_default();
+    if isos.is_empty() {
+        return Err("no iso".into());
+    }
     let dtype = v["dtype"].as_str().ok_or("no dtype")?.to_string();
     let raw = std::fs::read(json.with_extension("raw")).map_err(|e| e.to_string())?;
     Ok((
         Meta {
             dims: dims.try_into().map_err(|_| "dims need 3 values")?,
             dtype,
-            iso,
+            isos,
         },
         raw,
     ))

@@ -17,6 +17,7 @@ pub struct Mesh {
 }
 
 impl Sink for Mesh {
+    #[inline]
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
         self.positions.push(position);
         if let Some(n) = normal {
@@ -24,6 +25,7 @@ impl Sink for Mesh {
         }
     }
 
+    #[inline]
     fn triangle(&mut self, triangle: [u32; 3]) {
         self.triangles.push(triangle);
     }

@@ -48,14 +48,24 @@ pub fn extract_par<T: Scalar>(
         progress(dims[2] - 1);
         return Ok(mesh);
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|_| Error::ThreadPool)?;
+    // Rayon's global pool when it has the threads asked for: building a pool starts threads,
+    // which costs a noticeable share of a small volume's extraction.
+    let own_pool = if threads == 0 || threads == rayon::current_num_threads() {
+        None
+    } else {
+        Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|_| Error::ThreadPool)?,
+        )
+    };
     let layers = dims[2] - 1;
-    let workers = pool.current_num_threads();
+    let workers = own_pool
+        .as_ref()
+        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     // A few chunks per thread balance uneven surfaces without much re-reading at the seams.
-    let chunks = (workers * 4).min(layers.div_ceil(MIN_CHUNK_LAYERS)).max(1);
+    let chunks = (workers * 2).min(layers.div_ceil(MIN_CHUNK_LAYERS)).max(1);
     let bounds: Vec<(usize, usize)> = (0..chunks)
         .map(|c| (c * layers / chunks, (c + 1) * layers / chunks))
         .collect();
@@ -63,7 +73,7 @@ pub fn extract_par<T: Scalar>(
         data: volume.data(),
         nxy: dims[0] * dims[1],
     };
-    pool.install(|| {
+    let run = || {
         let parts: Vec<Result<Part, Error>> = bounds
             .par_iter()
             // Scratch is reused by the chunks one worker runs, rather than faulted in per chunk.
@@ -85,7 +95,11 @@ pub fn extract_par<T: Scalar>(
             )
             .collect();
         stitch(parts.into_iter().collect::<Result<Vec<_>, _>>()?)
-    })
+    };
+    match own_pool {
+        Some(pool) => pool.install(run),
+        None => run(),
+    }
 }
 
 /// Concatenates chunk meshes, shifting each chunk's ids by its start in the global order. The

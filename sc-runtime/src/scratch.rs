@@ -29,6 +29,10 @@ pub(crate) const SPAN_ROWS: usize = 7;
 impl<'a> Scratch<'a> {
     /// The buffer sizes a sweep over `dims` needs.
     pub fn len(dims: [usize; 3]) -> Result<ScratchLen, Error> {
+        // Row spans are stored in 31 bits.
+        if dims[0] >= 1 << 31 {
+            return Err(Error::DimsOverflow(dims));
+        }
         let nxy = dims[0]
             .checked_mul(dims[1])
             .ok_or(Error::DimsOverflow(dims))?;

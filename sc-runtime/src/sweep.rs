@@ -13,10 +13,13 @@
 
 use crate::scratch::{Scratch, WORD_PLANES};
 use crate::tables::{Entry, NO_EAR, grey_edge};
-use crate::vertex::{Field, edge_crossing};
+use crate::vertex::{Field, sample_crossing};
 
 mod bound;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
+
+/// The top bit of a classified row's span words: its first and last bytes (see `Grid::ends`).
+const END_BIT: u32 = 1 << 31;
 
 /// Vertex id of a grey edge merged away by Step 4.
 const MERGED: u32 = u32::MAX;
@@ -59,6 +62,9 @@ struct Grid<'s> {
     /// (local indices); everything, except for a block, whose halo is only read.
     own_cubes: [(usize, usize); 3],
     own_edges: [(usize, usize); 3],
+    /// Whether `own_edges` leaves any edge out (a block's sweep): otherwise the per-vertex
+    /// ownership test is skipped.
+    restricted: bool,
 }
 
 /// Vertex numbering and counts.
@@ -78,6 +84,8 @@ pub(crate) struct Sweep<'s, T: Scalar> {
     threshold: T::Threshold,
     /// The layer `start` prepared: where this sweep's output began.
     first_layer: usize,
+    /// The gradient's reciprocal steps, computed once.
+    steps: [[f64; 2]; 3],
 }
 
 impl<'s, T: Scalar> Sweep<'s, T> {
@@ -97,6 +105,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 offset: [0; 3],
                 own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
                 own_edges: dims.map(|n| (0, n)),
+                restricted: false,
             },
             out: Out {
                 ids,
@@ -107,6 +116,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             params: *params,
             threshold: T::threshold(params.iso),
             first_layer: 0,
+            steps: Field::<T>::steps(params.spacing),
         }
     }
 
@@ -118,6 +128,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let dims = self.grid.dims;
         self.grid.offset = offset;
         self.grid.own_cubes = own;
+        self.grid.restricted = true;
         self.grid.own_edges = core::array::from_fn(|d| {
             (
                 own[d].0,
@@ -195,19 +206,22 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     fn field<'v>(&self, src: &'v impl Slices<T>, z_lo: usize, z_hi: usize) -> Field<'v, T> {
         let nz = self.grid.dims[2];
         let first = z_lo.saturating_sub(1);
-        let mut slices = [None; 4];
+        // Slices past the grid stay empty: reading one fails like an index past the data.
+        let mut slices: [&[T]; 4] = [&[]; 4];
         for (i, z) in (first..=(z_hi + 1).min(nz - 1)).enumerate() {
-            slices[i] = Some(src.slice(z));
+            slices[i] = src.slice(z);
         }
         Field {
             dims: self.grid.dims,
-            spacing: self.params.spacing,
+            steps: self.steps,
             slices,
             first,
         }
     }
 
     /// Vertices on the x- and y-edges of plane `n`, row by row.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn plane_vertices(
         &mut self,
         n: usize,
@@ -216,26 +230,35 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     ) -> Result<(), Error> {
         let [nx, ny, _] = self.grid.dims;
         let field = self.field(src, n, n);
+        let samples = src.slice(n);
         let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
+        let [px, py, pz] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
             let row = grid.row(n, y);
+            let values = &samples[y * nx..][..nx];
             let (lo, hi) = grid.span(grid.slice_row(n, y));
-            let [px, py, pz] = grid.offset.map(|o| o & 1);
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
+            let ids = xbase + y * nx;
             for_each_differing(row, &row[1..], lo, hi, |x| {
-                let id = out.edge_vertex(grid, params, [x, y, n], 0, x_grey, &field, sink)?;
-                out.ids[xbase + y * nx + x] = id;
+                let ends = (values[x], values[x + 1]);
+                let id =
+                    out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, &field, sink)?;
+                out.ids[ids + x] = id;
                 Ok(())
             })?;
             if y + 1 < ny {
                 let next = grid.row(n, y + 1);
-                let (start, end) = grid.union_span(&[(y, n), (y + 1, n)]);
+                let next_values = &samples[(y + 1) * nx..][..nx];
+                let (start, end) = grid.union_span([(y, n), (y + 1, n)]);
+                let ids = ybase + y * nx;
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
-                    let id = out.edge_vertex(grid, params, [x, y, n], 1, grey, &field, sink)?;
-                    out.ids[ybase + y * nx + x] = id;
+                    let ends = (values[x], next_values[x]);
+                    let id =
+                        out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, &field, sink)?;
+                    out.ids[ids + x] = id;
                     Ok(())
                 })?;
             }
@@ -244,6 +267,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Vertices on the z-edges of layer `k`, row by row.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn z_vertices(
         &mut self,
         k: usize,
@@ -252,16 +277,21 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     ) -> Result<(), Error> {
         let [nx, ny, _] = self.grid.dims;
         let field = self.field(src, k, k + 1);
+        let (lower, upper) = (src.slice(k), src.slice(k + 1));
         let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
             let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
-            let (start, end) = grid.union_span(&[(y, k), (y, k + 1)]);
+            let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
+            let (start, end) = grid.union_span([(y, k), (y, k + 1)]);
+            let ids = zbase + y * nx;
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
-                let id = out.edge_vertex(grid, params, [x, y, k], 2, grey, &field, sink)?;
-                out.ids[zbase + y * nx + x] = id;
+                let ends = (lower[x], upper[x]);
+                let id =
+                    out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, &field, sink)?;
+                out.ids[ids + x] = id;
                 Ok(())
             })?;
         }
@@ -269,25 +299,31 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Steps 3 and 4: each cube's table triangles, with the ears of merged grey edges replaced.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn triangles(&mut self, k: usize, sink: &mut impl Sink) {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
         let (lo, hi) = (k % 2, (k + 1) % 2);
-        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`.
-        let edge_at: [usize; 12] = core::array::from_fn(|e| {
+        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`;
+        // sixteen entries, so that an edge number masked with 15 needs no bounds check.
+        let edge_at: [usize; 16] = core::array::from_fn(|e| {
             let r = e % 4;
             let (a, b) = (r & 1, r >> 1);
             match e / 4 {
                 0 => [lo, hi][b] * 2 * nxy + a * nx,
                 1 => [lo, hi][b] * 2 * nxy + nxy + a,
-                _ => 4 * nxy + a + b * nx,
+                2 => 4 * nxy + a + b * nx,
+                _ => 0,
             }
         });
         // Where each class's three grey-edge ids live, relative to the cube's `i + nx * j`.
         let grey_at: [[usize; 3]; 8] = GREYS.map(|g| g.map(|e| edge_at[usize::from(e)]));
         let grid = &self.grid;
         let ids = &*self.out.ids;
-        let stats = &mut self.out.stats;
+        // Counted in locals, added to the stats once: stores to the stats on every cube could
+        // not be moved past the loop's bounds checks.
+        let (mut t13, mut triangles) = (0u64, 0u64);
         let merging = grid.mode != Mode::Steps123;
         let entries = grid.entries;
         let [ox, oy, oz] = grid.offset;
@@ -297,15 +333,18 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let cases = &grid.cases[(k % 3) * nxy + j * nx..][..nx];
             let class_jk = ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
             let (start, end) = (start.max(x_lo), end.min(x_hi));
-            for (i, &case) in cases.iter().enumerate().take(end).skip(start) {
+            if start >= end {
+                continue;
+            }
+            for (i, &case) in (start..).zip(&cases[start..end]) {
                 if case == 0 || case == 255 {
                     continue;
                 }
                 let class = ((i + ox) & 1) | class_jk;
                 let entry = &entries[class * 256 + usize::from(case)];
-                stats.t13 += u64::from(entry.count);
+                t13 += u64::from(entry.count);
                 let at = i + nx * j;
-                let id = |e: u8| ids[edge_at[usize::from(e)] + at];
+                let id = |e: u8| ids[edge_at[usize::from(e & 15)] + at];
                 // A merged grey edge's ear is dropped; the pair's owner emits the merged
                 // triangle in its place (its partner emits nothing). Masks rather than branches:
                 // which greys merged is data, and data-dependent branches mispredict.
@@ -322,7 +361,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                     while owned != 0 {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
-                        stats.triangles += 1;
+                        triangles += 1;
                         let t = grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at);
                         sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
@@ -331,11 +370,14 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 while kept != 0 {
                     let n = kept.trailing_zeros() as usize;
                     kept &= kept - 1;
-                    stats.triangles += 1;
-                    sink.cube_triangle([i + ox, j + oy, k + oz], entry.tris[n].map(id));
+                    triangles += 1;
+                    let [a, b, c] = entry.tris[n];
+                    sink.cube_triangle([i + ox, j + oy, k + oz], [id(a), id(b), id(c)]);
                 }
             }
         }
+        self.out.stats.t13 += t13;
+        self.out.stats.triangles += triangles;
     }
 }
 
@@ -373,28 +415,30 @@ const GREYS: [[u8; 3]; 8] = {
 };
 
 impl Out<'_> {
-    /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number.
+    /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number. The
+    /// axis is a constant so each pass gets its own copy with the axis tests folded away; the
+    /// caller reads the edge's two samples straight from its rows.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn edge_vertex<T: Scalar>(
+    #[inline(always)]
+    fn edge_vertex<T: Scalar, const AXIS: usize>(
         &mut self,
         grid: &Grid<'_>,
         params: &Params,
         p: [usize; 3],
-        axis: usize,
         grey: bool,
+        (a, b): (T, T),
         field: &Field<'_, T>,
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
         let mut decision = if grey {
-            grid.decide(p, axis)
+            grid.decide::<AXIS>(p)
         } else {
             Decision::Keep
         };
         let mut bounded = false;
         if decision == Decision::Merge
             && let Some(bound) = params.max_error
-            && !grid.within_bound(p, axis, bound, field, params)
+            && !grid.within_bound(p, AXIS, bound, field, params)
         {
             decision = Decision::Blocked;
             bounded = true;
@@ -416,22 +460,24 @@ impl Out<'_> {
         self.next_id += 1;
         if self.emit {
             self.stats.vertices += u64::from(counted);
-            let t = edge_crossing(field, p, axis, params.iso);
+            let t = sample_crossing(a, b, params.iso);
             let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
             let pos: [f32; 3] = core::array::from_fn(|d| {
-                let c = global[d] as f64 + if d == axis { t } else { 0.0 };
+                // Through i64: one instruction, where usize to f64 takes several; exact below 2^53.
+                let c = global[d] as i64 as f64 + if d == AXIS { t } else { 0.0 };
                 (params.origin[d] + c * params.spacing[d]) as f32
             });
             let normal = params
                 .normals
-                .then(|| field.normal(p, axis, t, grid.is_filled(p)));
-            sink.edge_vertex(global, axis, pos, normal);
+                .then(|| field.normal(p, AXIS, t, grid.is_filled(p)));
+            sink.edge_vertex(global, AXIS, pos, normal);
         }
         Ok(id)
     }
 }
 
 impl Grid<'_> {
+    #[inline(always)]
     fn row(&self, z: usize, y: usize) -> &[u8] {
         let [nx, ny, _] = self.dims;
         &self.filled[(z % 4) * nx * ny + y * nx..][..nx]
@@ -441,9 +487,11 @@ impl Grid<'_> {
     #[inline(always)]
     fn owns_edge(&self, p: [usize; 3]) -> bool {
         let [x, y, z] = self.own_edges;
-        p[0] >= x.0 && p[0] < x.1 && p[1] >= y.0 && p[1] < y.1 && p[2] >= z.0 && p[2] < z.1
+        !self.restricted
+            || p[0] >= x.0 && p[0] < x.1 && p[1] >= y.0 && p[1] < y.1 && p[2] >= z.0 && p[2] < z.1
     }
 
+    #[inline(always)]
     fn is_filled(&self, p: [usize; 3]) -> bool {
         self.row(p[2], p[1])[p[0]] == 1
     }
@@ -458,8 +506,17 @@ impl Grid<'_> {
 
     fn span(&self, row: usize) -> (usize, usize) {
         (
-            self.spans[2 * row] as usize,
-            self.spans[2 * row + 1] as usize,
+            (self.spans[2 * row] & !END_BIT) as usize,
+            (self.spans[2 * row + 1] & !END_BIT) as usize,
+        )
+    }
+
+    /// A classified row's first and last bytes, kept in its span's top bits: [`Grid::union_span`]
+    /// then reads only the compact spans, not two cache lines of each row.
+    fn ends(&self, row: usize) -> (u32, u32) {
+        (
+            self.spans[2 * row] & END_BIT,
+            self.spans[2 * row + 1] & END_BIT,
         )
     }
 
@@ -469,14 +526,14 @@ impl Grid<'_> {
     }
 
     /// Step 1's classification of slice `z`, and each row's span of x-edge changes.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn classify<T: Scalar>(&mut self, z: usize, slice: &[T], threshold: T::Threshold) {
         let [nx, ny, _] = self.dims;
         let slot = (z % 4) * nx * ny;
         for y in 0..ny {
             let row = &mut self.filled[slot + y * nx..][..nx];
-            for (o, v) in row.iter_mut().zip(&slice[y * nx..][..nx]) {
-                *o = u8::from(v.filled(threshold));
-            }
+            T::classify_row(&slice[y * nx..][..nx], threshold, row);
             let span = match first_differing(row, row[0]) {
                 None => (nx - 1, 0),
                 Some(first) => (
@@ -484,25 +541,30 @@ impl Grid<'_> {
                     last_differing(row, row[nx - 1]).map_or(0, |l| l + 1),
                 ),
             };
-            self.set_span(self.slice_row(z, y), span);
+            let (first, last) = (u32::from(row[0]) << 31, u32::from(row[nx - 1]) << 31);
+            let r = self.slice_row(z, y);
+            self.set_span(r, span);
+            self.spans[2 * r] |= first;
+            self.spans[2 * r + 1] |= last;
         }
     }
 
     /// The x range `start..end` outside which the rows `(y, z)` agree with each other and are
     /// constant along x.
-    fn union_span(&self, rows: &[(usize, usize)]) -> (usize, usize) {
+    #[inline(always)]
+    fn union_span<const N: usize>(&self, rows: [(usize, usize); N]) -> (usize, usize) {
         let nx = self.dims[0];
-        let first = self.row(rows[0].1, rows[0].0);
-        let (f0, f1) = (first[0], first[nx - 1]);
+        let (f0, f1) = self.ends(self.slice_row(rows[0].1, rows[0].0));
         let (mut lo, mut hi) = (nx - 1, 0);
         let (mut same0, mut same1) = (true, true);
-        for &(y, z) in rows {
-            let (l, h) = self.span(self.slice_row(z, y));
+        for (y, z) in rows {
+            let row = self.slice_row(z, y);
+            let (l, h) = self.span(row);
             lo = lo.min(l);
             hi = hi.max(h);
-            let r = self.row(z, y);
-            same0 &= r[0] == f0;
-            same1 &= r[nx - 1] == f1;
+            let (e0, e1) = self.ends(row);
+            same0 &= e0 == f0;
+            same1 &= e1 == f1;
         }
         let start = if same0 { lo } else { 0 };
         let end = if same1 { hi + 1 } else { nx };
@@ -510,34 +572,38 @@ impl Grid<'_> {
     }
 
     /// Cube cases of layer `k`, over each cube row's span of non-trivial cubes.
+    // Not inlined: each pass runs once per layer, and apart it shows in a profile.
+    #[inline(never)]
     fn compute_cases(&mut self, k: usize) {
         let [nx, ny, _] = self.dims;
         for j in 0..ny - 1 {
             let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)];
             // Points `start..end` may vary, so cubes `start..end - 1` may be non-trivial.
-            let (start, end) = self.union_span(&rows);
+            let (start, end) = self.union_span(rows);
             let span = (start, (end.max(1) - 1).max(start));
             self.set_span(self.case_row(k, j), span);
             let (lo, hi) = span;
             if lo >= hi {
                 continue;
             }
-            let [r0, r1, r2, r3] =
-                rows.map(|(y, z)| &self.filled[(z % 4) * nx * ny + y * nx..][lo..=hi]);
-            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..hi - lo];
-            for (i, o) in out.iter_mut().enumerate() {
-                *o = r0[i]
-                    | r0[i + 1] << 1
-                    | r1[i] << 2
-                    | r1[i + 1] << 3
-                    | r2[i] << 4
-                    | r2[i + 1] << 5
-                    | r3[i] << 6
-                    | r3[i + 1] << 7;
+            // Row by row, each a zip of plain slices, so that the loops vectorise.
+            let len = hi - lo;
+            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..len];
+            for (n, (y, z)) in rows.into_iter().enumerate() {
+                let r = &self.filled[(z % 4) * nx * ny + y * nx + lo..][..=len];
+                let pairs = r.iter().zip(&r[1..]).map(|(a, b)| a | b << 1);
+                if n == 0 {
+                    out.iter_mut().zip(pairs).for_each(|(o, p)| *o = p);
+                } else {
+                    out.iter_mut()
+                        .zip(pairs)
+                        .for_each(|(o, p)| *o |= p << (2 * n));
+                }
             }
         }
     }
 
+    #[inline(always)]
     fn case_at(&self, i: usize, j: usize, k: usize) -> u8 {
         let [nx, ny, _] = self.dims;
         self.cases[(k % 3) * nx * ny + j * nx + i]
@@ -546,6 +612,7 @@ impl Grid<'_> {
     /// The four cubes around the edge from `p` along `axis`, as `(i, j, k)`, if it is interior:
     /// the lower two then the upper two along the third axis, each pair ordered along the
     /// remaining one.
+    #[inline(always)]
     fn cubes_around(&self, p: [usize; 3], axis: usize) -> Option<[(usize, usize, usize); 4]> {
         let [l, m, n] = p;
         let [nx, ny, nz] = self.dims;
@@ -564,13 +631,16 @@ impl Grid<'_> {
     }
 
     /// The parity class of a cube of these samples, which follows its global indices.
+    #[inline(always)]
     fn class_of(&self, (i, j, k): (usize, usize, usize)) -> usize {
         let [ox, oy, oz] = self.offset;
         ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2
     }
 
-    /// Step 4's decision for the occupied grey edge from `p` along `axis` (SPEC §5).
-    fn decide(&self, p: [usize; 3], axis: usize) -> Decision {
+    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5).
+    #[inline(always)]
+    fn decide<const AXIS: usize>(&self, p: [usize; 3]) -> Decision {
+        let axis = AXIS;
         if self.mode == Mode::Steps123 {
             return Decision::Keep;
         }
@@ -580,11 +650,13 @@ impl Grid<'_> {
         if self.mode == Mode::Paper {
             return Decision::Merge;
         }
-        let mergeable = cubes.iter().all(|&(i, j, k)| {
+        // All four bits ANDed, not a short-circuit: one branch on the result instead of four
+        // on the data.
+        let mergeable = cubes.iter().fold(1u8, |all, &(i, j, k)| {
             let class = self.class_of((i, j, k));
-            self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis & 1 == 1
+            all & self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis
         });
-        if mergeable && !self.pinch(p, axis) {
+        if mergeable & 1 == 1 && !self.pinch(p, axis) {
             Decision::Merge
         } else {
             Decision::Blocked
@@ -602,6 +674,7 @@ impl Grid<'_> {
     /// and their quads lie (wholly or in part) in the plane `z = n` with different diagonals:
     /// coplanar triangles overlap. Found by the self-intersection tests on real MRI data; the
     /// stricter test costs a few triangles (the knot: 10,520 instead of 10,516).
+    #[inline(always)]
     fn pinch(&self, p: [usize; 3], axis: usize) -> bool {
         let centre = self.is_filled(p);
         // Face planes as pairs of axes spanning them.
@@ -649,7 +722,7 @@ impl Grid<'_> {
         [i, j, k]: [usize; 3],
         axis: usize,
         entry: &Entry,
-        edge_at: &[usize; 12],
+        edge_at: &[usize; 16],
     ) -> [u32; 3] {
         let [ox, oy, oz] = self.offset;
         let along_y = axis == 0 || (axis == 2 && (k + oz).is_multiple_of(2));
@@ -661,8 +734,8 @@ impl Grid<'_> {
         let outer = |e: &Entry, at: usize| {
             let [b, _, f] = e.tris[usize::from(e.ears[axis])];
             (
-                ids[edge_at[usize::from(b)] + at],
-                ids[edge_at[usize::from(f)] + at],
+                ids[edge_at[usize::from(b & 15)] + at],
+                ids[edge_at[usize::from(f & 15)] + at],
             )
         };
         let (ba, fa) = outer(entry, i + nx * j);
@@ -704,13 +777,15 @@ fn for_each_differing(
     Ok(())
 }
 
-/// The first index whose byte differs from `v`, comparing 16 bytes at a time.
+/// The first index whose byte differs from `v`, comparing eight bytes at a time.
 fn first_differing(row: &[u8], v: u8) -> Option<usize> {
-    let chunks = row.chunks_exact(16);
+    let splat = u64::from_ne_bytes([v; 8]);
+    let chunks = row.chunks_exact(8);
     let tail = chunks.remainder();
     for (c, chunk) in chunks.enumerate() {
-        if chunk != [v; 16] {
-            return chunk.iter().position(|&b| b != v).map(|i| c * 16 + i);
+        let d = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ splat;
+        if d != 0 {
+            return Some(c * 8 + d.trailing_zeros() as usize / 8);
         }
     }
     tail.iter()
@@ -718,14 +793,16 @@ fn first_differing(row: &[u8], v: u8) -> Option<usize> {
         .map(|i| row.len() - tail.len() + i)
 }
 
-/// The last index whose byte differs from `v`, comparing 16 bytes at a time.
+/// The last index whose byte differs from `v`, comparing eight bytes at a time.
 fn last_differing(row: &[u8], v: u8) -> Option<usize> {
-    let chunks = row.rchunks_exact(16);
+    let splat = u64::from_ne_bytes([v; 8]);
+    let chunks = row.rchunks_exact(8);
     let head = chunks.remainder();
     for (c, chunk) in chunks.enumerate() {
-        if chunk != [v; 16] {
-            let start = row.len() - (c + 1) * 16;
-            return chunk.iter().rposition(|&b| b != v).map(|i| start + i);
+        let d = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ splat;
+        if d != 0 {
+            let start = row.len() - (c + 1) * 8;
+            return Some(start + (63 - d.leading_zeros() as usize) / 8);
         }
     }
     head.iter().rposition(|&b| b != v)

@@ -112,40 +112,28 @@ def marching_cubes(
             raise ValueError("Surface level must be within volume data range.")
 
     # The native call works in (x, y, z) with x fastest in memory: the array's axes reversed
-    # for a C-ordered array, as they are for a Fortran-ordered one.
+    # for a C-ordered array, as they are for a Fortran-ordered one. Ours wind outward from
+    # `>= level` in (x, y, z). Reversing the axes of a C-ordered array is a reflection, which
+    # turns the winding round; scikit-image's 'descent' winds inward in the array's axes
+    # (negative signed volume), 'ascent' outward. Its normals point down the gradient either
+    # way, as ours do. The reordering, the winding and the values are done natively, on the
+    # arrays the extraction made.
     c_order = volume.flags.c_contiguous
     axes = [2, 1, 0] if c_order else [0, 1, 2]
     xyz_spacing = tuple(spacing[a] * step_size for a in axes)
-    verts, faces, normals, _ = _native.extract(
-        volume, level, xyz_spacing, (0.0, 0.0, 0.0), "embedded", True, int(threads)
+    flip = c_order != (gradient_direction == "descent")
+    verts, faces, normals, values = _native.skimage_mesh(
+        volume, level, xyz_spacing, int(threads), c_order, flip
     )
     if len(faces) == 0:
         raise RuntimeError("No surface found at the given iso value.")
-    if c_order:
-        verts = verts[:, ::-1]
-        normals = normals[:, ::-1]
-    # Ours wind outward from `>= level` in (x, y, z). Reversing the axes of a C-ordered array is
-    # a reflection, which turns the winding round; scikit-image's 'descent' winds inward in the
-    # array's axes (negative signed volume), 'ascent' outward. Its normals point down the
-    # gradient either way, as ours do.
-    flip = c_order != (gradient_direction == "descent")
-    faces = faces.astype(np.int32)
-    if flip:
-        faces = faces[:, ::-1]
-
-    index = verts / np.asarray([s * step_size for s in spacing], dtype=np.float32)
     if mask is not None:
+        index = verts / np.asarray([s * step_size for s in spacing], dtype=np.float32)
         faces = _masked(faces, index, mask)
-        verts, faces, normals, index = _compact(verts, faces, normals, index)
+        verts, faces, normals, values = _compact(verts, faces, normals, values)
         if len(faces) == 0:
             raise RuntimeError("No surface found at the given iso value.")
-    values = _edge_values(volume, index)
-    return (
-        np.ascontiguousarray(verts),
-        np.ascontiguousarray(faces),
-        np.ascontiguousarray(normals),
-        values,
-    )
+    return verts, faces, normals, values
 
 
 def _masked(faces, index, mask):
@@ -157,29 +145,9 @@ def _masked(faces, index, mask):
     return faces[mask[cube[:, 0], cube[:, 1], cube[:, 2]]]
 
 
-def _compact(verts, faces, normals, index):
+def _compact(verts, faces, normals, values):
     """Drops vertices no face uses, renumbering the faces."""
     used = np.zeros(len(verts), dtype=bool)
     used[faces.ravel()] = True
     new = np.cumsum(used) - 1
-    return verts[used], new[faces].astype(np.int32), normals[used], index[used]
-
-
-def _edge_values(volume, index):
-    """Per vertex, the larger sample at the ends of its grid edge.
-
-    A vertex lies on a grid edge strictly between its ends (at least 1/1024 away), so one index
-    coordinate is fractional and the other two are whole: the lower end is the floor of all
-    three, the upper end one step further along the fractional axis.
-    """
-    if len(index) == 0:
-        return np.zeros(0, np.float32)
-    lower = np.floor(index)
-    step = (index != lower).astype(np.int64)
-    lower = lower.astype(np.int64)
-    strides = np.asarray(volume.strides) // volume.itemsize
-    flat = volume.reshape(-1, order="A")
-    first = lower @ strides
-    a = flat[first]
-    b = flat[first + step @ strides]
-    return np.maximum(a, b).astype(np.float32)
+    return verts[used], new[faces].astype(np.int32), normals[used], values[used]
