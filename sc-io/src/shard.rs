@@ -46,7 +46,9 @@ pub const VERSION: u64 = 1;
 pub const MANIFEST_NAME: &str = "manifest.json";
 
 /// What every block of one mesh must share besides the grid: the extractor's parameters (the
-/// case tables excepted, which a file cannot name).
+/// case tables excepted, which a file cannot name). A type of its own rather than [`Params`]
+/// because it must compare (a shard's against its manifest's) and round-trip through JSON,
+/// which the `&'static` tables forbid; each field is the [`Params`] field of the same name.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
     /// The iso value in stored units ([`Params::iso`]).

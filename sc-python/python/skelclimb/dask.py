@@ -5,7 +5,9 @@ Each task reads its chunk plus a thin halo (one sample before, three after), mes
 of merges joins the shares into exactly the mesh :func:`skelclimb.extract` makes of the whole
 array, whatever the chunking, the scheduler (threads, processes, a ``distributed`` cluster) or
 the order tasks finish in. Dask retries a task whose worker dies; since tasks are pure, the
-result is still exact.
+result is still exact. For a mesh too large for one machine, ``shards=DIR`` has each task
+write its share to a file instead, joined later by :func:`skelclimb.merge_shards` or
+``skelclimb merge``.
 
 >>> import dask.array as da, numpy as np, skelclimb.dask
 >>> z, y, x = np.mgrid[-1:1:48j, -1:1:48j, -1:1:48j]
