@@ -293,6 +293,14 @@ fn a_missing_shard_is_named() {
     merge_fails(d, "p/manifest.json", "block-8-0-8.npz: no such file");
 }
 
+/// Where `needle` first occurs in `hay` at or after `from`.
+fn find(hay: &[u8], needle: &[u8], from: usize) -> usize {
+    from + hay[from..]
+        .windows(needle.len())
+        .position(|w| w == needle)
+        .unwrap()
+}
+
 #[test]
 fn a_damaged_shard_is_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -302,6 +310,17 @@ fn a_damaged_shard_is_named() {
     let bytes = std::fs::read(&shard).unwrap();
     // Cut short, and the keys' order broken: both are refused, naming the file.
     std::fs::write(&shard, &bytes[..bytes.len() / 2]).unwrap();
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "block-8-8-8.npz: not a readable shard",
+    );
+    // One bit of one vertex coordinate flipped: the entry's CRC-32 catches it.
+    let name = find(&bytes, b"positions.npy", 0);
+    let end = find(&bytes, b"PK\x03\x04", name);
+    let mut flipped = bytes.clone();
+    flipped[end - 1] ^= 1;
+    std::fs::write(&shard, &flipped).unwrap();
     merge_fails(
         d,
         "p/manifest.json",

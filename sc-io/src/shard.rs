@@ -463,8 +463,9 @@ where
 pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
     let bad = |m: &str| Error::file(path, format!("not a readable shard: {m}"));
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let limit = file.metadata().map_err(|e| Error::io(path, e))?.len();
     let mut npz = NpzArchive::new(BufReader::new(file)).map_err(|e| bad(&e.to_string()))?;
-    let header: Vec<u8> = array(&mut npz, "header", 1).map_err(|m| bad(&m))?;
+    let header: Vec<u8> = array(&mut npz, "header", 1, limit).map_err(|m| bad(&m))?;
     let header: Value =
         serde_json::from_slice(&header).map_err(|e| bad(&format!("header: {e}")))?;
     if header["format"] != SHARD_FORMAT {
@@ -483,26 +484,42 @@ pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
         covered: header["covered"]
             .as_u64()
             .ok_or_else(|| bad("no cube count"))?,
-        keys: array(&mut npz, "keys", 1).map_err(|m| bad(&m))?,
-        positions: rows(array(&mut npz, "positions", 3).map_err(|m| bad(&m))?),
-        normals: rows(array(&mut npz, "normals", 3).map_err(|m| bad(&m))?),
-        triangles: rows(array(&mut npz, "triangles", 3).map_err(|m| bad(&m))?),
-        cubes: array(&mut npz, "cubes", 1).map_err(|m| bad(&m))?,
+        keys: array(&mut npz, "keys", 1, limit).map_err(|m| bad(&m))?,
+        positions: rows(array(&mut npz, "positions", 3, limit).map_err(|m| bad(&m))?),
+        normals: rows(array(&mut npz, "normals", 3, limit).map_err(|m| bad(&m))?),
+        triangles: rows(array(&mut npz, "triangles", 3, limit).map_err(|m| bad(&m))?),
+        cubes: array(&mut npz, "cubes", 1, limit).map_err(|m| bad(&m))?,
     };
     block.check().map_err(|e| bad(&e.to_string()))?;
     Ok((block, settings))
 }
 
 /// The array `name`, of shape `(n,)` for `width` 1 or `(n, width)` otherwise, flattened.
+///
+/// The entry is read whole first, so that the zip reader reaches its end and checks the CRC-32
+/// the writer recorded: a flipped byte in a shard is then an error, not a wrong vertex. Shards
+/// are stored uncompressed, so no entry can be longer than the file, `limit`.
 fn array<T: npyz::Deserialize, R: Read + Seek>(
     npz: &mut NpzArchive<R>,
     name: &str,
     width: usize,
+    limit: u64,
 ) -> std::result::Result<Vec<T>, String> {
-    let npy = npz
-        .by_name(name)
-        .map_err(|e| format!("array {name}: {e}"))?
-        .ok_or_else(|| format!("no array {name}"))?;
+    let mut bytes = Vec::new();
+    let file = npyz::npz::file_name_from_array_name(name);
+    let entry = match npz.zip_archive().by_name(&file) {
+        Ok(entry) => entry,
+        Err(npyz::zip::result::ZipError::FileNotFound) => return Err(format!("no array {name}")),
+        Err(e) => return Err(format!("array {name}: {e}")),
+    };
+    entry
+        .take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("array {name}: {e}"))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!("array {name} is longer than the file"));
+    }
+    let npy = npyz::NpyFile::new(&bytes[..]).map_err(|e| format!("array {name}: {e}"))?;
     let shape = npy.shape().to_vec();
     let fits = match shape.as_slice() {
         [_] => width == 1,
