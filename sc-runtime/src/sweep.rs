@@ -744,7 +744,8 @@ impl Grid<'_> {
             ba == fb || bb == fa,
             "ears around a merged grey edge share a face side"
         );
-        if ba == fb { [fa, ba, bb] } else { [fb, fa, ba] }
+        // Which ear's side the two share is data: a conditional move, not a branch.
+        core::hint::select_unpredictable(ba == fb, [fa, ba, bb], [fb, fa, ba])
     }
 }
 
