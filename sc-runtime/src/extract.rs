@@ -34,8 +34,8 @@ pub(crate) fn has_cubes(dims: [usize; 3]) -> bool {
 /// let mut data = [0u8; 27];
 /// data[13] = 1;
 /// let len = Scratch::len([3, 3, 3]).unwrap();
-/// let (mut bytes, mut words) = ([0u8; 64], [0u32; 128]);
-/// assert!(len.bytes <= 64 && len.words <= 128);
+/// let (mut bytes, mut words) = ([0u8; 256], [0u32; 128]);
+/// assert!(len.bytes <= 256 && len.words <= 128);
 /// let scratch = Scratch::new(&mut bytes, &mut words, [3, 3, 3]).unwrap();
 /// let mut sink = Count(0, 0);
 /// let stats = extract_into(&Volume::new(&data, [3, 3, 3]).unwrap(), &Params::new(1.0), scratch, &mut sink).unwrap();

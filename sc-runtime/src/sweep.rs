@@ -12,7 +12,7 @@
 //! rows can disagree.
 
 use crate::scratch::{Scratch, WORD_PLANES};
-use crate::tables::{Entry, NO_EAR, grey_edge};
+use crate::tables::{Entry, NO_EAR};
 use crate::vertex::{Field, sample_crossing};
 
 mod bound;
@@ -71,6 +71,9 @@ struct Grid<'s> {
 struct Out<'s> {
     /// Two planes of x- then y-edge ids (plane `n` at `n % 2`), then one layer of z-edge ids.
     ids: &'s mut [u32],
+    /// Two layers of cube marks (layer `k` at `k % 2`): bit `axis` set iff that grey edge of
+    /// the cube merged. The triangle pass reads one byte per cube instead of three vertex ids.
+    merged: &'s mut [u8],
     next_id: u32,
     /// False while numbering a first plane that the previous parallel chunk emits.
     emit: bool,
@@ -92,6 +95,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     pub fn new(dims: [usize; 3], params: &Params, scratch: Scratch<'s>) -> Self {
         let nxy = dims[0] * dims[1];
         let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy);
+        let (rest, merged) = rest.split_at_mut(3 * nxy);
         let (ids, spans) = scratch.words.split_at_mut(WORD_PLANES * nxy);
         Sweep {
             grid: Grid {
@@ -100,7 +104,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 entries: params.tables.for_mode(params.mode),
                 mergeable: params.tables.mergeable(),
                 filled,
-                cases: &mut rest[..3 * nxy],
+                cases: rest,
                 spans,
                 offset: [0; 3],
                 own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
@@ -109,6 +113,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             },
             out: Out {
                 ids,
+                merged: &mut merged[..2 * nxy],
                 next_id: 0,
                 emit: true,
                 stats: Stats::default(),
@@ -167,6 +172,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         if z0 >= 1 {
             self.grid.compute_cases(z0 - 1);
         }
+        // Plane z0's merges mark the cubes of layers z0 − 1 and z0.
+        self.out.merged.fill(0);
         self.grid.compute_cases(z0);
         self.first_layer = z0;
         self.out.emit = emit_plane;
@@ -187,6 +194,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 .classify::<T>(k + 2, src.slice(k + 2), self.threshold);
             self.grid.compute_cases(k + 1);
         }
+        // Plane k + 1's merges start marking layer k + 1, whose slot layer k − 1 used.
+        let nxy = self.grid.dims[0] * self.grid.dims[1];
+        self.out.merged[((k + 1) % 2) * nxy..][..nxy].fill(0);
         self.z_vertices(k, src, sink)?;
         self.plane_vertices(k + 1, src, sink)?;
         let (own_lo, own_hi) = self.grid.own_cubes[2];
@@ -317,10 +327,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 _ => 0,
             }
         });
-        // Where each class's three grey-edge ids live, relative to the cube's `i + nx * j`.
-        let grey_at: [[usize; 3]; 8] = GREYS.map(|g| g.map(|e| edge_at[usize::from(e)]));
         let grid = &self.grid;
         let ids = &*self.out.ids;
+        let marks = &self.out.merged[(k % 2) * nxy..][..nxy];
         // Counted in locals, added to the stats once: stores to the stats on every cube could
         // not be moved past the loop's bounds checks.
         let (mut t13, mut triangles) = (0u64, 0u64);
@@ -350,10 +359,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 // which greys merged is data, and data-dependent branches mispredict.
                 let (mut merged, mut dropped) = (0u8, 0u8);
                 if merging {
-                    for (axis, &grey) in grey_at[class].iter().enumerate() {
-                        let ear = entry.ears[axis];
-                        // A grey without an ear reads a stale id here, but cannot count.
-                        let m = u8::from((ear != NO_EAR) & (ids[grey + at] == MERGED));
+                    let marks = marks[at];
+                    for (axis, &ear) in entry.ears.iter().enumerate() {
+                        let m = (marks >> axis) & u8::from(ear != NO_EAR);
                         merged |= m << axis;
                         dropped |= m << (ear & 7);
                     }
@@ -399,22 +407,19 @@ const OWNS: [u8; 8] = {
     owns
 };
 
-/// Each class's grey edges by axis, so the triangle loop need not recompute them per cube.
-const GREYS: [[u8; 3]; 8] = {
-    let mut g = [[0u8; 3]; 8];
-    let mut p = 0;
-    while p < 8 {
-        g[p] = [
-            grey_edge(p as u8, 0),
-            grey_edge(p as u8, 1),
-            grey_edge(p as u8, 2),
-        ];
-        p += 1;
-    }
-    g
-};
-
 impl Out<'_> {
+    /// Marks the four cubes around the merged grey edge from `p` along `AXIS` (see
+    /// [`Out::merged`]).
+    #[inline(always)]
+    fn mark_merged<const AXIS: usize>(&mut self, grid: &Grid<'_>, p: [usize; 3]) {
+        let [nx, ny, _] = grid.dims;
+        if let Some(cubes) = grid.cubes_around(p, AXIS) {
+            for (i, j, k) in cubes {
+                self.merged[(k % 2) * nx * ny + j * nx + i] |= 1 << AXIS;
+            }
+        }
+    }
+
     /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number. The
     /// axis is a constant so each pass gets its own copy with the axis tests folded away; the
     /// caller reads the edge's two samples straight from its rows.
@@ -451,6 +456,7 @@ impl Out<'_> {
             self.stats.bounded += u64::from(bounded);
         }
         if decision == Decision::Merge {
+            self.mark_merged::<AXIS>(grid, p);
             return Ok(MERGED);
         }
         let id = self.next_id;
