@@ -7,7 +7,8 @@ meshes labels, so its vertices sit on half-integer positions and are not interpo
 PyMCubes and zmesh here return none). Every time is the median of --repeat runs of the whole
 call, conversions from and to NumPy included, on one thread (VTK's SMP tools set to 1, skelclimb
 with threads=1). Volumes: the built-in 256³ sphere, knot and noisy sphere (as bench/compare.py
-builds them), and the raw + JSON volumes of SC_DATA_DIR at their suggested iso values.
+builds them), and the raw + JSON volumes of SC_DATA_DIR (folders separated by ':', for example
+the shared data and what bench/derive_volumes.py makes of it) at their suggested iso values.
 
     python3 -m venv target/bench-venv
     target/bench-venv/bin/pip install ./sc-python scikit-image PyMCubes zmesh vtk
@@ -48,13 +49,15 @@ def data_volumes(data_dir):
     if not data_dir:
         print("SC_DATA_DIR not set: the real volumes are skipped", file=sys.stderr)
         return
-    for name in sorted(os.listdir(data_dir)):
-        meta_path = os.path.join(data_dir, name, name + ".json")
+    # Folders separated by os.pathsep, as the Rust benchmarks take them.
+    found = [(d, name) for d in data_dir.split(os.pathsep) if d for name in os.listdir(d)]
+    for folder, name in sorted(found, key=lambda f: f[1]):
+        meta_path = os.path.join(folder, name, name + ".json")
         if not os.path.exists(meta_path):
             continue
         meta = json.load(open(meta_path))
         nx, ny, nz = meta["dims"]
-        raw = np.fromfile(os.path.join(data_dir, name, name + ".raw"), dtype=DTYPES[meta["dtype"]])
+        raw = np.fromfile(os.path.join(folder, name, name + ".raw"), dtype=DTYPES[meta["dtype"]])
         for label, iso in meta.get("iso_suggestions", {}).items():
             if isinstance(iso, (int, float)):
                 yield f"{name}@{iso} ({label})", raw.reshape(nz, ny, nx), float(iso)
