@@ -318,3 +318,42 @@ fn a_truncated_nifti_header_is_described_in_words() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_flipped_byte_in_an_npz_member_fails_its_crc() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let npz = std::fs::read(fixture("stent-ct.npz")).unwrap();
+    // The one member's deflate data starts after its local header (30 bytes, name, extra field).
+    let field = |at: usize| usize::from(u16::from_le_bytes([npz[at], npz[at + 1]]));
+    let data = 30 + field(26) + field(28);
+    let inflate = |bytes: &[u8]| {
+        let mut out = Vec::new();
+        flate2::read::DeflateDecoder::new(bytes)
+            .read_to_end(&mut out)
+            .map(|_| out)
+    };
+    let original = inflate(&npz[data..]).unwrap();
+    // A flip that leaves the deflate stream valid, so only the CRC-32 can tell: the samples
+    // change but their number does not.
+    let flipped = (npz.len() / 2..npz.len() - 100)
+        .step_by(101)
+        .map(|at| {
+            let mut bytes = npz.clone();
+            bytes[at] ^= 0x10;
+            bytes
+        })
+        .find(|bytes| {
+            inflate(&bytes[data..]).is_ok_and(|out| out.len() == original.len() && out != original)
+        })
+        .expect("no flip keeps the deflate stream valid");
+    std::fs::write(d.join("flipped.npz"), flipped).unwrap();
+    refused(d, &["info", "flipped.npz"], 1, "flipped.npz");
+    refused(
+        d,
+        &["extract", "flipped.npz", "--iso", "250", "-o", "m.ply"],
+        1,
+        "checksum",
+    );
+}

@@ -258,8 +258,9 @@ pub struct Block<'a> {
     pub layout: Layout,
 }
 
-/// Decoded bytes read after the samples of a compressed block to reach its checksum.
-const MAX_TRAILING: u64 = 1 << 20;
+/// Decoded bytes read after the samples of a compressed block (or a zip member) to reach its
+/// checksum.
+pub(crate) const MAX_TRAILING: u64 = 1 << 20;
 
 /// Reads a sample block, with errors that name the data file and say what is missing.
 pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples> {

@@ -7,12 +7,13 @@
 //! moved; only the shape is read in the right direction.
 
 use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::io::{self, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use npyz::npz::NpzArchive;
 use npyz::{DType, NpyHeader, Order, TypeChar};
 
+use super::MAX_TRAILING;
 use super::payload::{self, Layout};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -50,7 +51,17 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
         }
     };
     match archive.by_name(&name) {
-        Ok(Some(npy)) => read_array(path, &npy.header().clone(), npy.into_inner(), progress),
+        Ok(Some(npy)) => {
+            let header = npy.header().clone();
+            let mut member = npy.into_inner();
+            let grid = read_array(path, &header, &mut member, progress)?;
+            // The zip reader compares a member's CRC-32 only when it is read to its end: without
+            // this, a flipped byte in the payload would mesh as an altered sample. What follows
+            // the samples is bounded, not trusted.
+            io::copy(&mut (&mut member).take(MAX_TRAILING), &mut io::sink())
+                .map_err(|e| Error::file(path, format!("array {name:?} is corrupt: {e}")))?;
+            Ok(grid)
+        }
         Ok(None) => Err(Error::file(
             path,
             format!(
