@@ -357,3 +357,52 @@ fn a_flipped_byte_in_an_npz_member_fails_its_crc() {
         "checksum",
     );
 }
+
+#[test]
+fn sigterm_during_extract_leaves_no_temporary_file() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("skelclimb"))
+        .current_dir(d)
+        .args([
+            "extract",
+            "--demo",
+            "sphere-noise",
+            "--size",
+            "400",
+            "--threads",
+            "1",
+        ])
+        .args(["-q", "-o", "m.ply"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The temporary mesh file is created before the volume is built; a moment later the command
+    // is building or meshing it (a 400³ volume on one thread takes seconds).
+    let start = Instant::now();
+    while entries(d).is_empty() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no temporary file"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(entries(d)[0].ends_with(".tmp"), "{:?}", entries(d));
+    std::thread::sleep(Duration::from_millis(800));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "extract ended before the signal"
+    );
+    // SAFETY: kill(2) on our own child, which has not been waited for, so its pid is still ours.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) },
+        0
+    );
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert_eq!(entries(d), Vec::<String>::new(), "files left behind");
+}
