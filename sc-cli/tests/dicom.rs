@@ -167,3 +167,33 @@ fn a_slice_claiming_huge_rows_and_columns_is_refused_before_decoding() {
         .stderr(contains("huge.dcm"))
         .stderr(contains("Rows 65535 × Columns 65535"));
 }
+
+#[test]
+fn an_element_claiming_four_gigabytes_is_refused_before_parsing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("long");
+    std::fs::create_dir(&dir).unwrap();
+    let mut bytes = std::fs::read(&slices()[9]).unwrap();
+    // A private OB element claiming 0xFFFFFFF0 bytes, just before the pixel data (tags ascend).
+    let pixel_data = bytes
+        .windows(6)
+        .rposition(|w| w == b"\xe0\x7f\x10\x00OW")
+        .unwrap();
+    let element = [
+        b"\x29\x00\x10\x10OB\x00\x00".as_slice(),
+        &0xFFFF_FFF0u32.to_le_bytes(),
+    ]
+    .concat();
+    bytes.splice(pixel_data..pixel_data, element);
+    std::fs::write(dir.join("long.dcm"), bytes).unwrap();
+    let started = std::time::Instant::now();
+    skelclimb()
+        .arg("info")
+        .arg(&dir)
+        .assert()
+        .code(1)
+        .stderr(contains("long.dcm"))
+        .stderr(contains("(0029,1010)"))
+        .stderr(contains("claims 4294967280 bytes"));
+    assert!(started.elapsed().as_secs() < 10);
+}

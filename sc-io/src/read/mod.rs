@@ -3,6 +3,7 @@
 //! progress are handled once.
 
 pub mod dicom;
+mod dicom_lengths;
 pub mod header;
 pub mod metaimage;
 pub mod nifti;
