@@ -51,3 +51,14 @@ fn the_corpus_reads_or_is_refused_with_the_file_named() {
         );
     }
 }
+
+#[test]
+fn past_findings_are_refused_with_the_file_named() {
+    let mut replayed = 0;
+    for target in Target::ALL {
+        let (accepted, refused) = replay("regressions", target);
+        replayed += accepted + refused;
+    }
+    // Findings are kept, never deleted: an empty folder means the path above is wrong.
+    assert!(replayed > 0, "no regression files found");
+}

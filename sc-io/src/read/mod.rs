@@ -294,7 +294,9 @@ pub(crate) fn open_block(block: &Block<'_>) -> Result<Box<dyn Read>> {
         Start::At(offset) => offset,
         Start::End => len.saturating_sub(need),
     };
-    if block.encoding == Encoding::Raw && block.skip_lines == 0 && len < start + need {
+    // Saturating: a header's offset near 2^64 must not wrap the end back into the file.
+    let end = start.saturating_add(need);
+    if block.encoding == Encoding::Raw && block.skip_lines == 0 && len < end {
         return Err(Error::file(
             path,
             format!(
@@ -302,7 +304,7 @@ pub(crate) fn open_block(block: &Block<'_>) -> Result<Box<dyn Read>> {
                  (truncated file, or dimensions larger than the data?)",
                 block.layout.count,
                 block.layout.dtype.name(),
-                start + need
+                end
             ),
         ));
     }
