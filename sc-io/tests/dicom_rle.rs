@@ -171,16 +171,13 @@ fn an_rle_series_reads_exactly_as_the_uncompressed_one() {
 #[test]
 fn a_corrupt_rle_segment_is_an_error_naming_the_slice() {
     let tmp = tempfile::tempdir().unwrap();
-    // The second segment's offset points past the fragment, and the segment count is wrong.
-    let cases: [(&str, fn(&mut Vec<u8>)); 2] = [
-        ("offset", |f| {
-            f[8..12].copy_from_slice(&u32::MAX.to_le_bytes())
-        }),
-        ("count", |f| f[0..4].copy_from_slice(&9u32.to_le_bytes())),
-    ];
-    for (name, damage) in cases {
+    // The second segment's offset points past the fragment; the segment count is wrong.
+    let cases = [("offset", 8, u32::MAX), ("count", 0, 9)];
+    for (name, at, value) in cases {
         let dir = tmp.path().join(name);
-        rle_series(&dir, 6, damage);
+        rle_series(&dir, 6, |f| {
+            f[at..at + 4].copy_from_slice(&value.to_le_bytes())
+        });
         let e = read(&dir, &ReadOptions::default(), &Silent)
             .unwrap_err()
             .to_string();
