@@ -1,14 +1,18 @@
 //! Replays the fuzzing corpus (`fuzz/corpus/<target>/`) and every file a fuzzer once broke a
 //! reader with (`fuzz/regressions/<target>/`) through the readers, as the AFL target does: each
-//! must read, or fail with an error naming the file, and never panic. This is how the findings
+//! must read, or fail with an error naming the file, in seconds, and never panic. This is how the findings
 //! of `fuzz/run.sh` stay fixed without AFL in the test suite.
 
 #[path = "../../fuzz/src/stage.rs"]
 mod stage;
 
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use stage::Target;
+
+/// Longer than any reader may take on a small file.
+const SLOW: Duration = Duration::from_secs(5);
 
 fn files(kind: &str, target: Target) -> Vec<PathBuf> {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -29,11 +33,15 @@ fn replay(kind: &str, target: Target) -> (usize, usize) {
     for file in files(kind, target) {
         let data = std::fs::read(&file).unwrap();
         let scratch = tempfile::tempdir().unwrap();
+        let started = Instant::now();
         match target.run(scratch.path(), &data) {
             Ok(true) => accepted += 1,
             Ok(false) => refused += 1,
             Err(why) => panic!("{}: {why}", file.display()),
         }
+        // AFL counts 2 s as a hang; this leaves room for a loaded test machine.
+        let took = started.elapsed();
+        assert!(took < SLOW, "{}: took {took:?}", file.display());
     }
     (accepted, refused)
 }
