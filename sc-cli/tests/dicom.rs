@@ -196,4 +196,23 @@ fn an_element_claiming_four_gigabytes_is_refused_before_parsing() {
         .stderr(contains("(0029,1010)"))
         .stderr(contains("claims 4294967280 bytes"));
     assert!(started.elapsed().as_secs() < 10);
+
+    // An unknown VR has a 32-bit length (as dicom-rs reads it): Manufacturer's "LO" turned into
+    // "LU" makes its value's first bytes, "GE M", a length of 1.3 GB (found by AFL).
+    let mut bytes = std::fs::read(&slices()[9]).unwrap();
+    let at = bytes
+        .windows(6)
+        .position(|w| w == b"\x08\x00\x70\x00LO")
+        .unwrap();
+    bytes[at + 5] = b'U';
+    std::fs::remove_file(dir.join("long.dcm")).unwrap();
+    std::fs::write(dir.join("unknown-vr.dcm"), bytes).unwrap();
+    skelclimb()
+        .arg("info")
+        .arg(&dir)
+        .assert()
+        .code(1)
+        .stderr(contains("unknown-vr.dcm"))
+        .stderr(contains("(0008,0070)"))
+        .stderr(contains("claims 1293960519 bytes"));
 }

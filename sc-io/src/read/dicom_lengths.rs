@@ -163,30 +163,40 @@ impl<R: Read + Seek> Walk<R> {
         self.data_set(encoding)
     }
 
-    /// An explicit VR element header after its tag: the VR and the value length.
+    /// An explicit VR element header after its tag: the VR and the value length. As in
+    /// dicom-rs (and PS3.5 7.1.2), the VRs listed have a 16-bit length; every other VR, an
+    /// unknown one included, has two reserved bytes and a 32-bit length.
     fn explicit_header(&mut self, e: Encoding) -> io::Result<([u8; 2], u32)> {
         let vr = self.bytes::<2>()?;
-        let long = matches!(
+        let short = matches!(
             &vr,
-            b"OB"
-                | b"OD"
-                | b"OF"
-                | b"OL"
-                | b"OV"
-                | b"OW"
-                | b"SQ"
-                | b"SV"
-                | b"UC"
-                | b"UN"
-                | b"UR"
-                | b"UT"
-                | b"UV"
+            b"AE"
+                | b"AS"
+                | b"AT"
+                | b"CS"
+                | b"DA"
+                | b"DS"
+                | b"DT"
+                | b"FL"
+                | b"FD"
+                | b"IS"
+                | b"LO"
+                | b"LT"
+                | b"PN"
+                | b"SH"
+                | b"SL"
+                | b"SS"
+                | b"ST"
+                | b"TM"
+                | b"UI"
+                | b"UL"
+                | b"US"
         );
-        let len = if long {
+        let len = if short {
+            u32::from(self.u16(e)?)
+        } else {
             self.bytes::<2>()?;
             self.u32(e)?
-        } else {
-            u32::from(self.u16(e)?)
         };
         Ok((vr, len))
     }
@@ -225,7 +235,7 @@ impl<R: Read + Seek> Walk<R> {
             }
             let (sequence, len) = if e.explicit {
                 let (vr, len) = self.explicit_header(e)?;
-                (&vr == b"SQ" || (&vr == b"UN" && len == UNDEFINED), len)
+                (&vr == b"SQ" || len == UNDEFINED, len)
             } else {
                 let len = self.u32(e)?;
                 let sq = StandardDataDictionary
