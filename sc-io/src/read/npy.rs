@@ -50,6 +50,11 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
             ));
         }
     };
+    // npyz parses a member's header as it opens it: check the header first, as for `.npy`.
+    let member = npyz::npz::file_name_from_array_name(&name);
+    if let Ok(mut raw) = archive.zip_archive().by_name(&member) {
+        check_header(path, &mut raw)?;
+    }
     match archive.by_name(&name) {
         Ok(Some(npy)) => {
             let header = npy.header().clone();
