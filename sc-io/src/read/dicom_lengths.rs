@@ -104,15 +104,31 @@ impl<R: Read + Seek> Walk<R> {
         })
     }
 
-    /// Skips a value of `claimed` bytes, refusing it if the file is shorter.
-    fn skip(&mut self, tag: Tag, claimed: u32) -> Result<(), Found> {
+    /// Refuses `claimed` bytes if fewer remain in the file.
+    fn fits(&self, tag: Tag, claimed: u32) -> Result<(), Found> {
         let at = self.pos;
         if u64::from(claimed) > self.len.saturating_sub(at) {
             return Err(Found::TooLong { tag, claimed, at });
         }
+        Ok(())
+    }
+
+    /// Skips a value of `claimed` bytes, refusing it if the file is shorter.
+    fn skip(&mut self, tag: Tag, claimed: u32) -> Result<(), Found> {
+        self.fits(tag, claimed)?;
         self.reader.seek_relative(i64::from(claimed))?;
         self.pos += u64::from(claimed);
         Ok(())
+    }
+
+    /// Enters a sequence or item of `claimed` bytes: where it ends, or `None` for an undefined
+    /// length; refused if the file is shorter.
+    fn open(&self, tag: Tag, claimed: u32) -> Result<Option<u64>, Found> {
+        if claimed == UNDEFINED {
+            return Ok(None);
+        }
+        self.fits(tag, claimed)?;
+        Ok(Some(self.pos + u64::from(claimed)))
     }
 
     /// The preamble, the meta group (always explicit VR little endian), then the data set in the
@@ -219,7 +235,7 @@ impl<R: Read + Seek> Walk<R> {
                 let len = self.u32(e)?;
                 match tag {
                     ITEM if in_fragments => self.skip(tag, len)?,
-                    ITEM => ends.push((len != UNDEFINED).then(|| self.pos + u64::from(len))),
+                    ITEM => ends.push(self.open(tag, len)?),
                     SEQUENCE_END if in_fragments => {
                         in_fragments = false;
                         if ends.is_empty() {
@@ -246,14 +262,7 @@ impl<R: Read + Seek> Walk<R> {
             if tag == PIXEL_DATA && len == UNDEFINED {
                 in_fragments = true;
             } else if sequence {
-                ends.push((len != UNDEFINED).then(|| self.pos + u64::from(len)));
-                if len != UNDEFINED && u64::from(len) > self.len.saturating_sub(self.pos) {
-                    return Err(Found::TooLong {
-                        tag,
-                        claimed: len,
-                        at: self.pos,
-                    });
-                }
+                ends.push(self.open(tag, len)?);
             } else {
                 self.skip(tag, len)?;
                 if tag == PIXEL_DATA && ends.is_empty() {
