@@ -167,3 +167,51 @@ fn a_slice_claiming_huge_rows_and_columns_is_refused_before_decoding() {
         .stderr(contains("huge.dcm"))
         .stderr(contains("Rows 65535 × Columns 65535"));
 }
+
+/// A one-slice series `name` holding `bytes`: `info` must refuse it at once, naming the slice
+/// and saying which element claims how many bytes.
+fn refused_before_parsing(name: &str, bytes: Vec<u8>, element: &str, claimed: u64) {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join(name), bytes).unwrap();
+    let started = std::time::Instant::now();
+    skelclimb()
+        .arg("info")
+        .arg(tmp.path())
+        .assert()
+        .code(1)
+        .stderr(contains(name))
+        .stderr(contains(element))
+        .stderr(contains(format!("claims {claimed} bytes")));
+    assert!(started.elapsed().as_secs() < 10);
+}
+
+#[test]
+fn an_element_claiming_four_gigabytes_is_refused_before_parsing() {
+    let mut bytes = std::fs::read(&slices()[9]).unwrap();
+    // A private OB element claiming 0xFFFFFFF0 bytes, just before the pixel data (tags ascend).
+    let pixel_data = bytes
+        .windows(6)
+        .rposition(|w| w == b"\xe0\x7f\x10\x00OW")
+        .unwrap();
+    let element = [
+        b"\x29\x00\x10\x10OB\x00\x00".as_slice(),
+        &0xFFFF_FFF0u32.to_le_bytes(),
+    ]
+    .concat();
+    bytes.splice(pixel_data..pixel_data, element);
+    refused_before_parsing("long.dcm", bytes, "(0029,1010)", 0xFFFF_FFF0);
+}
+
+#[test]
+fn an_unknown_vr_is_read_with_a_32_bit_length() {
+    // As dicom-rs reads it: Manufacturer's "LO" turned into "LU" makes its value's first bytes,
+    // "GE M", a length of 1.3 GB (found by AFL).
+    let mut bytes = std::fs::read(&slices()[9]).unwrap();
+    let at = bytes
+        .windows(6)
+        .position(|w| w == b"\x08\x00\x70\x00LO")
+        .unwrap();
+    bytes[at + 5] = b'U';
+    let claimed = u32::from_le_bytes(*b"GE M");
+    refused_before_parsing("unknown-vr.dcm", bytes, "(0008,0070)", claimed.into());
+}

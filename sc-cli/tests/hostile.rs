@@ -318,3 +318,91 @@ fn a_truncated_nifti_header_is_described_in_words() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_flipped_byte_in_an_npz_member_fails_its_crc() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let npz = std::fs::read(fixture("stent-ct.npz")).unwrap();
+    // The one member's deflate data starts after its local header (30 bytes, name, extra field).
+    let field = |at: usize| usize::from(u16::from_le_bytes([npz[at], npz[at + 1]]));
+    let data = 30 + field(26) + field(28);
+    let inflate = |bytes: &[u8]| {
+        let mut out = Vec::new();
+        flate2::read::DeflateDecoder::new(bytes)
+            .read_to_end(&mut out)
+            .map(|_| out)
+    };
+    let original = inflate(&npz[data..]).unwrap();
+    // A flip that leaves the deflate stream valid, so only the CRC-32 can tell: the samples
+    // change but their number does not.
+    let flipped = (npz.len() / 2..npz.len() - 100)
+        .step_by(101)
+        .map(|at| {
+            let mut bytes = npz.clone();
+            bytes[at] ^= 0x10;
+            bytes
+        })
+        .find(|bytes| {
+            inflate(&bytes[data..]).is_ok_and(|out| out.len() == original.len() && out != original)
+        })
+        .expect("no flip keeps the deflate stream valid");
+    std::fs::write(d.join("flipped.npz"), flipped).unwrap();
+    refused(d, &["info", "flipped.npz"], 1, "flipped.npz");
+    refused(
+        d,
+        &["extract", "flipped.npz", "--iso", "250", "-o", "m.ply"],
+        1,
+        "checksum",
+    );
+}
+
+#[test]
+fn sigterm_during_extract_leaves_no_temporary_file() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("skelclimb"))
+        .current_dir(d)
+        .args([
+            "extract",
+            "--demo",
+            "sphere-noise",
+            "--size",
+            "400",
+            "--threads",
+            "1",
+        ])
+        .args(["-q", "-o", "m.ply"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The temporary mesh file is created before the volume is built; a moment later the command
+    // is building or meshing it (a 400³ volume on one thread takes seconds).
+    let start = Instant::now();
+    while entries(d).is_empty() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no temporary file"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(entries(d)[0].ends_with(".tmp"), "{:?}", entries(d));
+    std::thread::sleep(Duration::from_millis(800));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "extract ended before the signal"
+    );
+    // SAFETY: kill(2) on our own child, which has not been waited for, so its pid is still ours.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) },
+        0
+    );
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert_eq!(entries(d), Vec::<String>::new(), "files left behind");
+}

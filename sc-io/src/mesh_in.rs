@@ -148,8 +148,19 @@ fn obj(path: &Path) -> Result<TriangleMesh> {
         single_index: true,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(path, &options)
-        .map_err(|e| Error::file(path, format!("not a readable OBJ file: {e}")))?;
+    let bad = |m: String| Error::file(path, format!("not a readable OBJ file: {m}"));
+    let mut reader = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+    // tobj multiplies a face's resolved normal and texture indices unchecked: an out-of-range
+    // relative index overflows (a panic where overflow checks are on; found by fuzzing). And
+    // materials are never loaded: only the geometry is used, and a `mtllib` line may name any
+    // file (`/dev/zero` would be read without end).
+    let (models, _) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut reader, &options, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+    }))
+    .map_err(|_| bad("malformed face indices".into()))?
+    .map_err(|e| bad(e.to_string()))?;
     let mut mesh = TriangleMesh::default();
     for m in models {
         let base = mesh.positions.len() as u32;

@@ -74,6 +74,7 @@ pub fn list_series(dir: &Path) -> Result<Vec<SeriesInfo>> {
 fn headers(dir: &Path) -> Result<Vec<Slice>> {
     let mut slices = Vec::new();
     for path in dicom_files(dir)? {
+        super::dicom_lengths::check(&path)?;
         let obj = OpenFileOptions::new()
             .read_until(tags::PIXEL_DATA)
             .open_file(&path)

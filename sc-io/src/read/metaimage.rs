@@ -6,7 +6,7 @@ use std::io::BufReader;
 use std::path::Path;
 
 use super::header::{Syntax, TextHeader};
-use super::payload::{Encoding, Layout};
+use super::payload::{self, Encoding, Layout};
 use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -79,7 +79,11 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
         layout: Layout {
             dtype,
             endian,
-            count: dims.iter().product(),
+            count: payload::sample_count(dims).ok_or_else(|| {
+                h.error(format!(
+                    "sizes {dims:?} hold more samples than memory can address"
+                ))
+            })?,
         },
     };
     let mut grid = Grid::new(read_block(&block, progress)?, dims, "MetaImage");

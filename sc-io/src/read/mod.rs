@@ -3,6 +3,7 @@
 //! progress are handled once.
 
 pub mod dicom;
+mod dicom_lengths;
 pub mod header;
 pub mod metaimage;
 pub mod nifti;
@@ -258,8 +259,9 @@ pub struct Block<'a> {
     pub layout: Layout,
 }
 
-/// Decoded bytes read after the samples of a compressed block to reach its checksum.
-const MAX_TRAILING: u64 = 1 << 20;
+/// Decoded bytes read after the samples of a compressed block (or a zip member) to reach its
+/// checksum.
+pub(crate) const MAX_TRAILING: u64 = 1 << 20;
 
 /// Reads a sample block, with errors that name the data file and say what is missing.
 pub fn read_block(block: &Block<'_>, progress: &dyn Progress) -> Result<Samples> {
@@ -292,7 +294,9 @@ pub(crate) fn open_block(block: &Block<'_>) -> Result<Box<dyn Read>> {
         Start::At(offset) => offset,
         Start::End => len.saturating_sub(need),
     };
-    if block.encoding == Encoding::Raw && block.skip_lines == 0 && len < start + need {
+    // Saturating: a header's offset near 2^64 must not wrap the end back into the file.
+    let end = start.saturating_add(need);
+    if block.encoding == Encoding::Raw && block.skip_lines == 0 && len < end {
         return Err(Error::file(
             path,
             format!(
@@ -300,7 +304,7 @@ pub(crate) fn open_block(block: &Block<'_>) -> Result<Box<dyn Read>> {
                  (truncated file, or dimensions larger than the data?)",
                 block.layout.count,
                 block.layout.dtype.name(),
-                start + need
+                end
             ),
         ));
     }

@@ -7,12 +7,13 @@
 //! moved; only the shape is read in the right direction.
 
 use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::io::{self, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use npyz::npz::NpzArchive;
 use npyz::{DType, NpyHeader, Order, TypeChar};
 
+use super::MAX_TRAILING;
 use super::payload::{self, Layout};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -49,8 +50,23 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
             ));
         }
     };
+    // npyz parses a member's header as it opens it: check the header first, as for `.npy`.
+    let member = npyz::npz::file_name_from_array_name(&name);
+    if let Ok(mut raw) = archive.zip_archive().by_name(&member) {
+        check_header(path, &mut raw)?;
+    }
     match archive.by_name(&name) {
-        Ok(Some(npy)) => read_array(path, &npy.header().clone(), npy.into_inner(), progress),
+        Ok(Some(npy)) => {
+            let header = npy.header().clone();
+            let mut member = npy.into_inner();
+            let grid = read_array(path, &header, &mut member, progress)?;
+            // The zip reader compares a member's CRC-32 only when it is read to its end: without
+            // this, a flipped byte in the payload would mesh as an altered sample. What follows
+            // the samples is bounded, not trusted.
+            io::copy(&mut (&mut member).take(MAX_TRAILING), &mut io::sink())
+                .map_err(|e| Error::file(path, format!("array {name:?} is corrupt: {e}")))?;
+            Ok(grid)
+        }
         Ok(None) => Err(Error::file(
             path,
             format!(
@@ -76,12 +92,16 @@ fn listing(names: &[String]) -> String {
     }
 }
 
-/// The longest `.npy` header we read: real ones are a few hundred bytes.
-const MAX_HEADER: usize = 1 << 16;
+/// The longest `.npy` header we read. A plain numeric array's header is about 120 bytes; only
+/// structured dtypes, which cannot be meshed anyway, make long ones. npyz's parser backtracks,
+/// so its time grows with the length as well as the nesting (fuzzing found headers of 64 KiB
+/// nested 7 deep that took seconds).
+const MAX_HEADER: usize = 1 << 12;
 
-/// Deepest bracket nesting accepted in a header: npyz's parser takes time exponential in it,
-/// and no real dtype nests more than a few levels.
-const MAX_NESTING: usize = 16;
+/// Deepest bracket nesting accepted in a header: npyz's parser takes time exponential in it
+/// (about ×3 a level: 11 unclosed braces took 5 s, 15 more than 20 s; found by fuzzing), and
+/// a plain array's header nests 2 deep (the dict, the shape tuple).
+const MAX_NESTING: usize = 6;
 
 /// Checks the header's declared length and nesting before the parser sees it, so that a hostile
 /// header can make it neither allocate gigabytes nor run for minutes.

@@ -39,6 +39,13 @@ impl Layout {
     }
 }
 
+/// The number of samples of a `dims` volume, or `None` if it overflows: a header's sizes are
+/// untrusted, and a wrapped product would describe a small volume that is not there (fuzzing
+/// found NRRD and MetaImage sizes whose product overflowed).
+pub fn sample_count(dims: [usize; 3]) -> Option<usize> {
+    dims.iter().try_fold(1usize, |n, &d| n.checked_mul(d))
+}
+
 /// `reader` with `encoding` undone.
 pub fn decode<'a>(reader: impl Read + 'a, encoding: Encoding) -> Box<dyn Read + 'a> {
     match encoding {
