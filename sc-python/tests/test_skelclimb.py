@@ -431,3 +431,19 @@ def test_max_error_bounds_the_merges():
             skelclimb.extract(f, 0.0, max_error=bad)
     with pytest.raises(ValueError, match="error_units"):
         skelclimb.extract(f, 0.0, max_error=0.1, error_units="mm")
+
+
+@pytest.mark.parametrize("level", [-0.5, 2.5])
+def test_marching_cubes_level_outside_the_data_is_a_value_error(level):
+    skimage = pytest.importorskip("skimage.measure")
+    vol = np.zeros((6, 6, 6), np.float32)
+    vol[2:4, 2:4, 2:4] = 2.0
+    for mc in (skelclimb.marching_cubes, skimage.marching_cubes):
+        with pytest.raises(ValueError, match="within volume data range"):
+            mc(vol, level)
+
+
+def test_marching_cubes_level_inside_the_data_without_surface_is_a_runtime_error():
+    # Every sample equals the level: in range, filled everywhere, no crossing.
+    with pytest.raises(RuntimeError, match="No surface found"):
+        skelclimb.marching_cubes(np.full((4, 4, 4), 3.0), 3.0)
