@@ -19,8 +19,8 @@ pub struct ScratchLen {
     pub words: usize,
 }
 
-/// Four classified slices, three layers of cube cases and two of merge marks, a byte per cell.
-pub(crate) const BYTE_PLANES: usize = 9;
+/// Four classified slices, three layers of cube cases and a plane of merge marks, a byte per cell.
+pub(crate) const BYTE_PLANES: usize = 8;
 /// Two planes of x- and y-edge vertex ids plus one layer of z-edge ids.
 pub(crate) const WORD_PLANES: usize = 5;
 /// Span pairs per row: four classified slices and three case layers.

@@ -71,8 +71,9 @@ struct Grid<'s> {
 struct Out<'s> {
     /// Two planes of x- then y-edge ids (plane `n` at `n % 2`), then one layer of z-edge ids.
     ids: &'s mut [u32],
-    /// Two layers of cube marks (layer `k` at `k % 2`): bit `axis` set iff that grey edge of
-    /// the cube merged. The triangle pass reads one byte per cube instead of three vertex ids.
+    /// Merge marks of two layers of cubes in one byte per cube: bit `3 · (k % 2) + axis` set iff
+    /// that grey edge of the cube in layer `k` merged. The triangle pass reads one byte per cube
+    /// instead of three vertex ids.
     merged: &'s mut [u8],
     next_id: u32,
     /// False while numbering a first plane that the previous parallel chunk emits.
@@ -95,7 +96,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     pub fn new(dims: [usize; 3], params: &Params, scratch: Scratch<'s>) -> Self {
         let nxy = dims[0] * dims[1];
         let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy);
-        let (rest, merged) = rest.split_at_mut(3 * nxy);
+        let (cases, merged) = rest.split_at_mut(3 * nxy);
         let (ids, spans) = scratch.words.split_at_mut(WORD_PLANES * nxy);
         Sweep {
             grid: Grid {
@@ -104,7 +105,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 entries: params.tables.for_mode(params.mode),
                 mergeable: params.tables.mergeable(),
                 filled,
-                cases: rest,
+                cases,
                 spans,
                 offset: [0; 3],
                 own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
@@ -113,7 +114,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             },
             out: Out {
                 ids,
-                merged: &mut merged[..2 * nxy],
+                merged: &mut merged[..nxy],
                 next_id: 0,
                 emit: true,
                 stats: Stats::default(),
@@ -194,9 +195,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 .classify::<T>(k + 2, src.slice(k + 2), self.threshold);
             self.grid.compute_cases(k + 1);
         }
-        // Plane k + 1's merges start marking layer k + 1, whose slot layer k − 1 used.
-        let nxy = self.grid.dims[0] * self.grid.dims[1];
-        self.out.merged[((k + 1) % 2) * nxy..][..nxy].fill(0);
+        // Plane k + 1's merges start marking layer k + 1, whose bits layer k − 1 used.
+        let stale = !(7u8 << (3 * ((k + 1) % 2)));
+        self.out.merged.iter_mut().for_each(|m| *m &= stale);
         self.z_vertices(k, src, sink)?;
         self.plane_vertices(k + 1, src, sink)?;
         let (own_lo, own_hi) = self.grid.own_cubes[2];
@@ -329,7 +330,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         });
         let grid = &self.grid;
         let ids = &*self.out.ids;
-        let marks = &self.out.merged[(k % 2) * nxy..][..nxy];
+        let (marks, shift) = (&*self.out.merged, 3 * (k % 2));
         // Counted in locals, added to the stats once: stores to the stats on every cube could
         // not be moved past the loop's bounds checks.
         let (mut t13, mut triangles) = (0u64, 0u64);
@@ -359,7 +360,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 // which greys merged is data, and data-dependent branches mispredict.
                 let (mut merged, mut dropped) = (0u8, 0u8);
                 if merging {
-                    let marks = marks[at];
+                    let marks = marks[at] >> shift;
                     for (axis, &ear) in entry.ears.iter().enumerate() {
                         let m = (marks >> axis) & u8::from(ear != NO_EAR);
                         merged |= m << axis;
@@ -412,10 +413,10 @@ impl Out<'_> {
     /// [`Out::merged`]).
     #[inline(always)]
     fn mark_merged<const AXIS: usize>(&mut self, grid: &Grid<'_>, p: [usize; 3]) {
-        let [nx, ny, _] = grid.dims;
+        let nx = grid.dims[0];
         if let Some(cubes) = grid.cubes_around(p, AXIS) {
             for (i, j, k) in cubes {
-                self.merged[(k % 2) * nx * ny + j * nx + i] |= 1 << AXIS;
+                self.merged[j * nx + i] |= 1 << (3 * (k % 2) + AXIS);
             }
         }
     }
