@@ -519,6 +519,7 @@ fn array<T: npyz::Deserialize, R: Read + Seek>(
     if bytes.len() as u64 > limit {
         return Err(format!("array {name} is longer than the file"));
     }
+    crate::read::npy::check_header(&mut &bytes[..]).map_err(|e| format!("array {name}: {e}"))?;
     let npy = npyz::NpyFile::new(&bytes[..]).map_err(|e| format!("array {name}: {e}"))?;
     let shape = npy.shape().to_vec();
     let fits = match shape.as_slice() {

@@ -12,6 +12,7 @@ use std::path::Path;
 
 use npyz::npz::NpzArchive;
 use npyz::{DType, NpyHeader, Order, TypeChar};
+use py_literal::Value;
 
 use super::MAX_TRAILING;
 use super::payload::{self, Layout};
@@ -27,11 +28,11 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     if !is_npz {
         let mut file = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
-        check_header(path, &mut file)?;
+        check_header(&mut file).map_err(|m| not_readable(path, m))?;
         file.seek(SeekFrom::Start(0))
             .map_err(|e| Error::io(path, e))?;
-        let header = NpyHeader::from_reader(&mut file)
-            .map_err(|e| Error::file(path, format!("not a readable .npy header: {e}")))?;
+        let header =
+            NpyHeader::from_reader(&mut file).map_err(|e| not_readable(path, e.to_string()))?;
         return read_array(path, &header, file, progress);
     }
     let mut archive = NpzArchive::open(path)
@@ -53,7 +54,7 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
     // npyz parses a member's header as it opens it: check the header first, as for `.npy`.
     let member = npyz::npz::file_name_from_array_name(&name);
     if let Ok(mut raw) = archive.zip_archive().by_name(&member) {
-        check_header(path, &mut raw)?;
+        check_header(&mut raw).map_err(|m| not_readable(path, m))?;
     }
     match archive.by_name(&name) {
         Ok(Some(npy)) => {
@@ -76,6 +77,10 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
         )),
         Err(e) => Err(Error::file(path, format!("array {name:?}: {e}"))),
     }
+}
+
+fn not_readable(path: &Path, message: String) -> Error {
+    Error::file(path, format!("not a readable .npy header: {message}"))
 }
 
 /// Array names for a message: the first ten, and how many more.
@@ -103,44 +108,69 @@ const MAX_HEADER: usize = 1 << 12;
 /// a plain array's header nests 2 deep (the dict, the shape tuple).
 const MAX_NESTING: usize = 6;
 
-/// Checks the header's declared length and nesting before the parser sees it, so that a hostile
-/// header can make it neither allocate gigabytes nor run for minutes.
-fn check_header(path: &Path, file: &mut impl Read) -> Result<()> {
-    let bad = |m: String| Error::file(path, format!("not a readable .npy header: {m}"));
+/// Checks the header's declared length, nesting and shape before npyz sees it, so that a hostile
+/// header can make it neither allocate gigabytes, run for minutes nor overflow: npyz multiplies
+/// the dimensions unchecked, which panics in a debug build and wraps in a release one (fuzzing
+/// found `(8888888888888888888+88888888888, 8)`, which its Python-literal parser sums).
+///
+/// The header is parsed here with the same parser npyz uses, so what passes is what npyz reads.
+pub(crate) fn check_header(file: &mut impl Read) -> std::result::Result<(), String> {
     let mut start = [0u8; 12];
     file.read_exact(&mut start[..10])
-        .map_err(|_| bad("the file is shorter than a header".into()))?;
+        .map_err(|_| "the file is shorter than a header".to_string())?;
     if &start[..6] != b"\x93NUMPY" {
-        return Err(bad("the file does not start with the .npy magic".into()));
+        return Err("the file does not start with the .npy magic".into());
     }
     let len = match start[6] {
         1 => usize::from(u16::from_le_bytes([start[8], start[9]])),
         2 | 3 => {
             file.read_exact(&mut start[10..12])
-                .map_err(|_| bad("the file is shorter than a header".into()))?;
+                .map_err(|_| "the file is shorter than a header".to_string())?;
             u32::from_le_bytes([start[8], start[9], start[10], start[11]]) as usize
         }
-        v => return Err(bad(format!("format version {v} is unknown"))),
+        v => return Err(format!("format version {v} is unknown")),
     };
     if len > MAX_HEADER {
-        return Err(bad(format!(
-            "a header length of {len} bytes is implausible"
-        )));
+        return Err(format!("a header length of {len} bytes is implausible"));
     }
     let mut text = vec![0u8; len];
     file.read_exact(&mut text)
-        .map_err(|_| bad(format!("the file ends inside its {len}-byte header")))?;
+        .map_err(|_| format!("the file ends inside its {len}-byte header"))?;
     let mut depth = 0usize;
     for &c in &text {
         match c {
             b'[' | b'(' | b'{' => {
                 depth += 1;
                 if depth > MAX_NESTING {
-                    return Err(bad(format!("brackets nest more than {MAX_NESTING} deep")));
+                    return Err(format!("brackets nest more than {MAX_NESTING} deep"));
                 }
             }
             b']' | b')' | b'}' => depth = depth.saturating_sub(1),
             _ => {}
+        }
+    }
+    let text = text.strip_suffix(b"\n").unwrap_or(&text);
+    let value: Value = std::str::from_utf8(text)
+        .map_err(|_| "the header is not UTF-8 text".to_string())?
+        .parse()
+        .map_err(|e| format!("the header is not a Python literal: {e}"))?;
+    let Value::Dict(entries) = value else {
+        return Err("the header is not a Python dict".into());
+    };
+    let shape = entries
+        .iter()
+        .find(|(key, _)| key.as_string().is_some_and(|k| k == "shape"))
+        .map(|(_, shape)| shape);
+    if let Some(Value::Tuple(dims) | Value::List(dims)) = shape {
+        let fits = dims.iter().try_fold(1u64, |n, d| {
+            let d = u64::try_from(d.as_integer()?).ok()?;
+            n.checked_mul(d)
+        });
+        if fits.is_none() {
+            return Err(format!(
+                "shape {} is not a list of sizes whose product fits in 64 bits",
+                Value::List(dims.clone())
+            ));
         }
     }
     Ok(())
