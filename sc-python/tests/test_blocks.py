@@ -120,6 +120,33 @@ def test_dask_checks_its_arguments():
         skelclimb.dask.extract(da.zeros((4, 4, 4), chunks=2), float("nan"))
 
 
+def test_dask_delayed_result_and_a_single_chunk():
+    v = blobs((20, 19, 18), 6)
+    with dask.config.set(scheduler="threads"):
+        for chunks in (6, v.shape):
+            result = skelclimb.dask.extract(da.from_array(v, chunks=chunks), 12, compute=False)
+            assert isinstance(result, dask.delayed(lambda: 0)().__class__)
+            same(result.compute(), skelclimb.extract(v, 12))
+
+
+def test_dask_tasks_are_prioritised_by_z_layer():
+    # A distributed worker runs lower z layers first, so it drops a layer's chunks before it
+    # loads many more; the priorities must survive into the graph the scheduler gets.
+    arr = da.from_array(blobs((24, 10, 10), 7), chunks=(6, 5, 10))
+    graph = skelclimb.dask.extract(arr, 12, compute=False).__dask_graph__()
+    priorities = {}
+    for layer in graph.layers.values():
+        p = (layer.annotations or {}).get("priority")
+        for key in layer if p is not None else ():
+            # Dask may merge layers and keep their annotations as a function of the key.
+            value = p(key) if callable(p) else p
+            if isinstance(value, int):
+                name = key if isinstance(key, str) else key[0]
+                priorities.setdefault(name.split("-")[0], set()).add(value)
+    assert priorities.get("_mesh") == {0, -1, -2, -3}
+    assert priorities.get("_slabs") == {0, -1, -2, -3}
+
+
 def _die_once(block, marker):
     """Kills the worker process running it, the first time any worker runs it."""
     try:

@@ -66,7 +66,8 @@ def _halos(blocks):
     """Per block (an object array of delayed chunks), its halos along x, then y, then z: one
     slab task per block and axis, fed by the halos before it, so that the edge and corner
     samples come along. Only the chunks themselves and thin slabs are ever held, never extended
-    copies, and only the slabs travel between workers."""
+    copies, and only the slabs travel between workers. Tasks are prioritised by z layer (see
+    :func:`extract`)."""
     import dask
 
     slabs = dask.delayed(_slabs, pure=True)
@@ -79,7 +80,8 @@ def _halos(blocks):
             continue
         edges = np.empty(blocks.shape, object)
         for idx in np.ndindex(blocks.shape):
-            edges[idx] = slabs(blocks[idx], axis, *halos[idx])
+            with dask.annotate(priority=-idx[0]):
+                edges[idx] = slabs(blocks[idx], axis, *halos[idx])
         for idx in np.ndindex(blocks.shape):
             step = tuple(int(a == axis) for a in range(3))
             i = idx[axis]
@@ -114,7 +116,7 @@ def _manifest(directory, grid, options, *records):
 
 
 def _merge(*shares):
-    return shares[0].merge(*shares[1:])
+    return shares[0].merge(*shares[1:]) if len(shares) > 1 else shares[0]
 
 
 def _finish(share):
@@ -227,14 +229,21 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
                     continue
                 cubes = (cx, cy, cz)
                 at = tuple(max(c[0] - 1, 0) for c in cubes)
-                shares.append(mesh(parts[iz, iy, ix], halos[iz, iy, ix], at, grid, cubes, options,
-                                   *tail))
+                # Lower z layers first: a distributed worker then meshes and drops a layer's
+                # chunks before it loads many more (1024³ in 128³ chunks on 2 workers: peaks
+                # of 447–466 MiB without priorities, 247–267 MiB with them).
+                with dask.annotate(priority=-iz):
+                    shares.append(mesh(parts[iz, iy, ix], halos[iz, iy, ix], at, grid, cubes,
+                                       options, *tail))
     if shards is not None:
         result = dask.delayed(_manifest, pure=True)(directory, grid, options, *shares)
         return result.compute() if compute else result
     merge = dask.delayed(_merge, pure=True)
-    while len(shares) > 1:
+    while len(shares) > int(split_every):
         shares = [merge(*shares[i:i + split_every])
                   for i in range(0, len(shares), int(split_every))]
-    result = dask.delayed(_finish, pure=True)(shares[0])
-    return result.compute() if compute else result
+    if compute:
+        # The last merge runs here, where the mesh is wanted anyway, so that no worker has to
+        # hold the whole mesh (and its inputs) on top of its chunks.
+        return _finish(_merge(*dask.compute(*shares)))
+    return dask.delayed(_finish, pure=True)(merge(*shares))
