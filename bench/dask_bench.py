@@ -55,7 +55,7 @@ def write_store(path, n, chunk):
 def peak_rss_mib():
     """This process's own peak resident memory. On Linux that is VmHWM: ``ru_maxrss`` also
     counts the parent's resident memory at the fork that started the process (the kernel keeps
-    it across ``exec``), which made idle Dask workers look 140–270 MiB large instead of 68."""
+    it across ``exec``), which made idle Dask workers look 140–270 MiB large instead of 67."""
     try:
         with open("/proc/self/status") as status:
             for line in status:

@@ -197,7 +197,8 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
     if array.ndim != 3:
         raise ValueError(f"array: expected 3 dimensions, got {array.ndim}")
-    if int(split_every) < 2:
+    split_every = int(split_every)
+    if split_every < 2:
         raise ValueError(f"split_every: must be at least 2, got {split_every}")
     nz, ny, nx = array.shape
     grid = (nx, ny, nz)
@@ -239,9 +240,8 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         result = dask.delayed(_manifest, pure=True)(directory, grid, options, *shares)
         return result.compute() if compute else result
     merge = dask.delayed(_merge, pure=True)
-    while len(shares) > int(split_every):
-        shares = [merge(*shares[i:i + split_every])
-                  for i in range(0, len(shares), int(split_every))]
+    while len(shares) > split_every:
+        shares = [merge(*shares[i:i + split_every]) for i in range(0, len(shares), split_every)]
     if compute:
         # The last merge runs here, where the mesh is wanted anyway, so that no worker has to
         # hold the whole mesh (and its inputs) on top of its chunks.
