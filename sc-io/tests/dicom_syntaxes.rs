@@ -208,3 +208,38 @@ fn a_corrupt_rle_segment_is_an_error_naming_the_slice() {
         assert!(e.contains("rle_005.dcm"), "{name}: {e}");
     }
 }
+
+#[test]
+fn bytes_after_the_pixel_data_are_not_parsed_encapsulated_or_not() {
+    // An element after the pixel data whose tag sorts before it, claiming 4 GB: dicom-rs, asked
+    // to stop at the pixel data, would still parse it and reserve the 4 GB (a fuzzed file did
+    // this after pixel data of an unknown VR; here it follows an RLE fragment sequence, which
+    // has no length to say where it ends).
+    let tmp = tempfile::tempdir().unwrap();
+    let (plain, rle, clean) = (
+        tmp.path().join("plain"),
+        tmp.path().join("rle"),
+        tmp.path().join("clean"),
+    );
+    plain_series(&clean, 6);
+    plain_series(&plain, 6);
+    rle_series(&rle, 6, |_| {});
+    let trailer = [
+        b"\x29\x00\x10\x10OB\x00\x00".as_slice(),
+        &0xFFFF_FF00u32.to_le_bytes(),
+    ]
+    .concat();
+    for dir in [&plain, &rle] {
+        for file in std::fs::read_dir(dir).unwrap() {
+            let path = file.unwrap().path();
+            let mut bytes = std::fs::read(&path).unwrap();
+            bytes.extend_from_slice(&trailer);
+            std::fs::write(&path, bytes).unwrap();
+        }
+    }
+    let want = read(&clean, &ReadOptions::default(), &Silent).unwrap();
+    for dir in [&plain, &rle] {
+        let got = read(dir, &ReadOptions::default(), &Silent).unwrap();
+        assert_eq!(got.samples, want.samples, "{}", dir.display());
+    }
+}

