@@ -32,11 +32,12 @@ __all__ = ["extract"]
 _AFTER = 3
 
 
-def _grown(block, halos, cut=None):
-    """``block`` extended along each axis of ``halos`` in turn. A halo is ``(axis, before,
-    after)``: the slabs of the neighbouring blocks along that axis (each already extended along
-    the axes before it), ``None`` at the grid's ends. With ``cut = (axis, slice)``, only that
-    slice along another axis is built: cutting before joining keeps the copy small."""
+def _grown(block, axes, halos, cut=None):
+    """``block`` extended along each of ``axes`` in turn by ``halos``, a flat sequence of
+    ``before, after`` pairs, one pair per axis: the slabs of the neighbouring blocks along that
+    axis (each already extended along the axes before it), ``None`` at the grid's ends. With
+    ``cut = (axis, slice)``, only that slice along another axis is built: cutting before joining
+    keeps the copy small."""
     def part(a):
         if cut is None:
             return np.asarray(a)
@@ -45,7 +46,8 @@ def _grown(block, halos, cut=None):
         return np.asarray(a[tuple(index)])
 
     out = part(block)
-    for axis, before, after in halos:
+    for n, axis in enumerate(axes):
+        before, after = halos[2 * n], halos[2 * n + 1]
         pieces = [part(before[1])] if before is not None else []
         pieces.append(out)
         if after is not None:
@@ -55,45 +57,42 @@ def _grown(block, halos, cut=None):
     return out
 
 
-def _slabs(block, axis, *halos):
-    """What ``block``'s neighbours along ``axis`` need of it, extended by ``halos``: its first
-    ``_AFTER`` samples (for the block before) and its last one (for the block after)."""
-    return (_grown(block, halos, (axis, slice(0, _AFTER))),
-            _grown(block, halos, (axis, slice(-1, None))))
+def _slabs(block, axis, axes, *halos):
+    """What ``block``'s neighbours along ``axis`` need of it, extended along ``axes`` by
+    ``halos``: its first ``_AFTER`` samples (for the block before) and its last one (for the
+    block after)."""
+    return (_grown(block, axes, halos, (axis, slice(0, _AFTER))),
+            _grown(block, axes, halos, (axis, slice(-1, None))))
 
 
-def _halos(blocks):
-    """Per block (an object array of delayed chunks), its halos along x, then y, then z: one
-    slab task per block and axis, fed by the halos before it, so that the edge and corner
-    samples come along. Only the chunks themselves and thin slabs are ever held, never extended
-    copies, and only the slabs travel between workers. Tasks are prioritised by z layer (see
-    :func:`extract`)."""
-    import dask
+def _halos(chunks, shape, name):
+    """The tasks that give each block its halos along x, then y, then z: one slab task per block
+    and axis, fed by the halos before it, so that the edge and corner samples come along. Only
+    the chunks themselves and thin slabs are ever held, never extended copies, and only the
+    slabs travel between workers.
 
-    slabs = dask.delayed(_slabs, pure=True)
-    halos = np.empty(blocks.shape, object)
-    for idx in np.ndindex(blocks.shape):
-        halos[idx] = []
-    for axis in (2, 1, 0):
-        n = blocks.shape[axis]
-        if n == 1:
-            continue
-        edges = np.empty(blocks.shape, object)
-        for idx in np.ndindex(blocks.shape):
-            with dask.annotate(priority=-idx[0]):
-                edges[idx] = slabs(blocks[idx], axis, *halos[idx])
-        for idx in np.ndindex(blocks.shape):
-            step = tuple(int(a == axis) for a in range(3))
+    ``chunks`` maps a block's index ``(iz, iy, ix)`` to its chunk's key. Returns the slab tasks
+    (a graph: key to task) and, per block index, the axes its halos extend and the flat
+    ``before, after`` keys along each (``None`` at the grid's ends)."""
+    tasks = {}
+    axes = tuple(a for a in (2, 1, 0) if shape[a] > 1)
+    halos = {idx: [] for idx in np.ndindex(shape)}
+    for n, axis in enumerate(axes):
+        for idx in np.ndindex(shape):
+            tasks[(name, axis) + idx] = (_slabs, chunks[idx], axis, axes[:n], *halos[idx])
+        step = tuple(int(a == axis) for a in range(3))
+        for idx in np.ndindex(shape):
             i = idx[axis]
-            before = edges[tuple(c - s for c, s in zip(idx, step))] if i > 0 else None
-            after = edges[tuple(c + s for c, s in zip(idx, step))] if i + 1 < n else None
-            halos[idx] = halos[idx] + [(axis, before, after)]
-    return halos
+            before = (name, axis) + tuple(c - s for c, s in zip(idx, step)) if i > 0 else None
+            after = (name, axis) + tuple(c + s for c, s in zip(idx, step)) \
+                if i + 1 < shape[axis] else None
+            halos[idx].extend((before, after))
+    return tasks, axes, halos
 
 
-def _mesh(block, halos, at, grid, cubes, options):
+def _mesh(block, axes, at, grid, cubes, options, *halos):
     """Meshes a block from its chunk and its halos."""
-    return extract_block(_grown(block, halos), at=at, grid=grid, cubes=cubes, **options)
+    return extract_block(_grown(block, axes, halos), at=at, grid=grid, cubes=cubes, **options)
 
 
 def _native_settings(options):
@@ -104,10 +103,10 @@ def _native_settings(options):
             bool(options["normals"]), _bound(options["max_error"], options["error_units"]))
 
 
-def _shard(block, halos, at, grid, cubes, options, directory):
+def _shard(directory, block, axes, at, grid, cubes, options, *halos):
     """Meshes one block and writes it as a shard; returns only the manifest's small record, so
     the worker keeps no mesh."""
-    share = _mesh(block, halos, at, grid, cubes, options)
+    share = _mesh(block, axes, at, grid, cubes, options, *halos)
     return _native.write_shard(share._share, directory, cubes, _native_settings(options))
 
 
@@ -188,6 +187,9 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     True
     """
     import dask
+    from dask.base import tokenize
+    from dask.delayed import Delayed
+    from dask.highlevelgraph import HighLevelGraph, MaterializedLayer
 
     from . import _MODES, _bound, _level, _triple
 
@@ -211,18 +213,20 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     # three after), as thin slabs from its neighbours, built one axis at a time (see _halos):
     # about five tasks per chunk where dask.array.overlap makes some 24, every chunk read once.
     array = array.rechunk(tuple(_at_least(c, _AFTER) for c in array.chunks))
-    parts = array.to_delayed()
-    halos = _halos(parts)
-    zc, yc, xc = array.chunks
-    if shards is not None:
-        directory = os.fspath(shards)
+    # The graph is written out here, task by task, rather than by calling dask.delayed
+    # functions: each such call merges and culls its arguments' graphs, which took 1.75 s for
+    # the 2,635 tasks of a 1024³ array in 128³ chunks.
+    keys = array.__dask_keys__()
+    shape = tuple(len(c) for c in array.chunks)
+    chunks = {idx: keys[idx[0]][idx[1]][idx[2]] for idx in np.ndindex(shape)}
+    directory = None if shards is None else os.fspath(shards)
+    token = tokenize(array.name, options, split_every, directory)
+    blocks, axes, halos = _halos(chunks, shape, "skelclimb-halo-" + token)
+    name = "skelclimb-block-" + token
+    if directory is not None:
         os.makedirs(directory, exist_ok=True)
-        mesh = dask.delayed(_shard, pure=True)
-        tail = (directory,)
-    else:
-        mesh = dask.delayed(_mesh, pure=True)
-        tail = ()
     shares = []
+    zc, yc, xc = array.chunks
     for iz, cz in enumerate(_cube_ranges(zc, nz)):
         for iy, cy in enumerate(_cube_ranges(yc, ny)):
             for ix, cx in enumerate(_cube_ranges(xc, nx)):
@@ -230,20 +234,50 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
                     continue
                 cubes = (cx, cy, cz)
                 at = tuple(max(c[0] - 1, 0) for c in cubes)
-                # Lower z layers first: a distributed worker then meshes and drops a layer's
-                # chunks before it loads many more (1024³ in 128³ chunks on 2 workers: peaks
-                # of 447–466 MiB without priorities, 247–267 MiB with them).
-                with dask.annotate(priority=-iz):
-                    shares.append(mesh(parts[iz, iy, ix], halos[iz, iy, ix], at, grid, cubes,
-                                       options, *tail))
-    if shards is not None:
-        result = dask.delayed(_manifest, pure=True)(directory, grid, options, *shares)
-        return result.compute() if compute else result
-    merge = dask.delayed(_merge, pure=True)
-    while len(shares) > split_every:
-        shares = [merge(*shares[i:i + split_every]) for i in range(0, len(shares), split_every)]
-    if compute:
-        # The last merge runs here, where the mesh is wanted anyway, so that no worker has to
-        # hold the whole mesh (and its inputs) on top of its chunks.
-        return _finish(_merge(*dask.compute(*shares)))
-    return dask.delayed(_finish, pure=True)(merge(*shares))
+                idx = (iz, iy, ix)
+                task = (chunks[idx], axes, at, grid, cubes, options, *halos[idx])
+                key = (name, *idx)
+                blocks[key] = (_mesh, *task) if directory is None else (_shard, directory, *task)
+                shares.append(key)
+    layers = dict(array.__dask_graph__().layers)
+    dependencies = dict(array.__dask_graph__().dependencies)
+    # Lower z layers first: a distributed worker then meshes and drops a layer's chunks before
+    # it loads many more (1024³ in 128³ chunks on 2 workers: peaks of 447–466 MiB without
+    # priorities, 247–267 MiB with them).
+    layers[name] = MaterializedLayer(blocks, annotations={**dask.get_annotations(),
+                                                          "priority": _by_z_layer})
+    dependencies[name] = set(array.__dask_layers__())
+    joins, last = {}, name
+    if directory is not None:
+        joins["skelclimb-manifest-" + token] = (_manifest, directory, grid, options, *shares)
+        shares = ["skelclimb-manifest-" + token]
+    else:
+        level_key = 0
+        while len(shares) > split_every:
+            merged = []
+            for i in range(0, len(shares), split_every):
+                key = ("skelclimb-merge-" + token, level_key, len(merged))
+                joins[key] = (_merge, *shares[i:i + split_every])
+                merged.append(key)
+            shares, level_key = merged, level_key + 1
+        if not compute:
+            joins["skelclimb-mesh-" + token] = (_merge, *shares)
+            joins["skelclimb-finish-" + token] = (_finish, "skelclimb-mesh-" + token)
+            shares = ["skelclimb-finish-" + token]
+    if joins:
+        last = "skelclimb-join-" + token
+        layers[last] = MaterializedLayer(joins)
+        dependencies[last] = {name}
+    graph = HighLevelGraph(layers, dependencies)
+    results = [Delayed(key, graph, layer=last) for key in shares]
+    if directory is not None or not compute:
+        return results[0].compute() if compute else results[0]
+    # The last merge runs here, where the mesh is wanted anyway, so that no worker has to hold
+    # the whole mesh (and its inputs) on top of its chunks.
+    return _finish(_merge(*dask.compute(*results)))
+
+
+def _by_z_layer(key):
+    """A block's or a halo slab's priority: its z layer's index, negated (Dask runs higher
+    priorities first). The layer's index is third from the end of every such key."""
+    return -key[-3]
