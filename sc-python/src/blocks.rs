@@ -78,11 +78,7 @@ pub fn merge_blocks<'py>(
         .iter()
         .map(from_python)
         .collect::<PyResult<Vec<_>>>()?;
-    let joined = py.detach(|| {
-        shares
-            .into_iter()
-            .try_fold(BlockMesh::default(), BlockMesh::merge)
-    });
+    let joined = py.detach(|| BlockMesh::merge_all(shares));
     to_python(py, joined.map_err(errors::runtime)?)?.into_pyobject(py)
 }
 

@@ -9,7 +9,9 @@
 //! sweep numbers vertices, and triangles are ordered by owning cube, so the joined mesh is
 //! byte-identical to [`crate::extract`]'s whatever the block shapes and the order of arrival.
 
+use alloc::collections::BinaryHeap;
 use alloc::vec::Vec;
+use core::cmp::Reverse;
 use core::ops::Range;
 
 use crate::extract::InMemory;
@@ -276,79 +278,91 @@ impl BlockMesh {
     /// and of their triangles (in cube order). Associative and commutative, so shares can be
     /// joined in any order or as a tree. Shares that own the same cube are refused.
     pub fn merge(self, other: BlockMesh) -> Result<BlockMesh, Error> {
-        if self.covered == 0 && self.keys.is_empty() {
-            return Ok(other);
-        }
-        if other.covered == 0 && other.keys.is_empty() {
-            return Ok(self);
-        }
-        if self.grid != other.grid
-            || (self.normals.is_empty() != other.normals.is_empty()
-                && !self.keys.is_empty()
-                && !other.keys.is_empty())
+        Self::merge_all([self, other])
+    }
+
+    /// Joins any number of shares at once, as [`BlockMesh::merge`] joins two: each vertex and
+    /// triangle is copied once, where folding `merge` over `k` shares copies the growing result
+    /// `k − 1` times.
+    ///
+    /// ```
+    /// use sc_runtime::{BlockMesh, Params, Volume, demo, extract, extract_block};
+    ///
+    /// let v = demo::torus(24);
+    /// let (volume, params) = (Volume::new(&v.data, v.dims).unwrap(), Params::new(v.iso));
+    /// // Three slabs of cubes, each meshed from the whole volume (a block may be given more
+    /// // samples than its halo needs).
+    /// let shares = [0..7, 7..15, 15..23].map(|z| {
+    ///     extract_block(&volume, [0, 0, 0], v.dims, [0..23, 0..23, z], &params).unwrap()
+    /// });
+    /// let whole = BlockMesh::merge_all(shares).unwrap().into_mesh().unwrap();
+    /// assert_eq!(whole, extract(&volume, &params).unwrap());
+    /// ```
+    pub fn merge_all(shares: impl IntoIterator<Item = BlockMesh>) -> Result<BlockMesh, Error> {
+        let shares: Vec<BlockMesh> = shares
+            .into_iter()
+            .filter(|s| s.covered != 0 || !s.keys.is_empty())
+            .collect();
+        let Some(first) = shares.first() else {
+            return Ok(BlockMesh::default());
+        };
+        let with_vertices = || shares.iter().filter(|s| !s.keys.is_empty());
+        let normals = with_vertices()
+            .next()
+            .is_some_and(|s| !s.normals.is_empty());
+        if shares.iter().any(|s| s.grid != first.grid)
+            || with_vertices().any(|s| s.normals.is_empty() == normals)
         {
             return Err(Error::BlocksDiffer);
         }
-        let (a, b) = (self, other);
+        let total = |f: fn(&BlockMesh) -> usize| shares.iter().map(f).sum::<usize>();
         let mut out = BlockMesh {
-            grid: a.grid,
-            stats: a.stats + b.stats,
-            covered: a.covered + b.covered,
-            ..BlockMesh::default()
+            grid: first.grid,
+            stats: shares.iter().fold(Stats::default(), |s, b| s + b.stats),
+            covered: shares.iter().map(|s| s.covered).sum(),
+            keys: Vec::with_capacity(total(|s| s.keys.len())),
+            positions: Vec::with_capacity(total(|s| s.keys.len())),
+            normals: Vec::with_capacity(total(|s| s.normals.len())),
+            triangles: Vec::with_capacity(total(|s| s.triangles.len())),
+            cubes: Vec::with_capacity(total(|s| s.cubes.len())),
         };
-        // Union of the sorted keys, with each side's old index → new index.
-        let (mut map_a, mut map_b) = (
-            Vec::with_capacity(a.keys.len()),
-            Vec::with_capacity(b.keys.len()),
-        );
-        let (mut i, mut j) = (0, 0);
-        while i < a.keys.len() || j < b.keys.len() {
-            let next = out.keys.len() as u32;
-            let (ka, kb) = (a.keys.get(i), b.keys.get(j));
-            let take_a = kb.is_none_or(|kb| ka.is_some_and(|ka| ka <= kb));
-            let take_b = ka.is_none_or(|ka| kb.is_some_and(|kb| kb <= ka));
-            let (src, at) = if take_a { (&a, i) } else { (&b, j) };
-            if take_a && take_b && a.positions[i] != b.positions[j] {
-                return Err(Error::BlocksDiffer);
-            }
-            out.keys.push(src.keys[at]);
-            out.positions.push(src.positions[at]);
-            if let Some(&n) = src.normals.get(at) {
-                out.normals.push(n);
-            }
-            if take_a {
-                map_a.push(next);
-                i += 1;
-            }
-            if take_b {
-                map_b.push(next);
-                j += 1;
-            }
-        }
-        // Triangles by owning cube; a cube's triangles all come from one side, in their order.
-        out.triangles.reserve(a.triangles.len() + b.triangles.len());
-        out.cubes.reserve(a.cubes.len() + b.cubes.len());
-        let (mut i, mut j) = (0, 0);
-        while i < a.cubes.len() || j < b.cubes.len() {
-            let (ca, cb) = (a.cubes.get(i), b.cubes.get(j));
-            if let (Some(ca), Some(cb)) = (ca, cb)
-                && ca == cb
-            {
-                return Err(Error::BlocksOverlap { cube: *ca });
-            }
-            let take_a = cb.is_none_or(|cb| ca.is_some_and(|ca| ca < cb));
-            let (side, map, at) = if take_a {
-                i += 1;
-                (&a, &map_a, i - 1)
+        // Vertices: the union of the sorted keys, with each share's old index → new index. A key
+        // in several shares (a vertex on a block's face) is one vertex, at one position.
+        let mut maps: Vec<Vec<u32>> = shares
+            .iter()
+            .map(|s| Vec::with_capacity(s.keys.len()))
+            .collect();
+        let mut differ = false;
+        merge_sorted(shares.iter().map(|s| &s.keys[..]), |s, at, again| {
+            let share = &shares[s];
+            if again {
+                differ |= out.positions.last() != Some(&share.positions[at]);
             } else {
-                j += 1;
-                (&b, &map_b, j - 1)
-            };
-            out.cubes.push(side.cubes[at]);
-            out.triangles
-                .push(side.triangles[at].map(|v| map[v as usize]));
+                out.keys.push(share.keys[at]);
+                out.positions.push(share.positions[at]);
+                out.normals.extend(share.normals.get(at));
+            }
+            maps[s].push(out.keys.len() as u32 - 1);
+        });
+        if differ {
+            return Err(Error::BlocksDiffer);
         }
-        Ok(out)
+        // Triangles by owning cube; a cube's triangles all come from one share, in their order.
+        let mut overlap = None;
+        merge_sorted(shares.iter().map(|s| &s.cubes[..]), |s, at, again| {
+            let share = &shares[s];
+            if again {
+                overlap.get_or_insert(share.cubes[at]);
+            } else {
+                out.cubes.push(share.cubes[at]);
+                out.triangles
+                    .push(share.triangles[at].map(|v| maps[s][v as usize]));
+            }
+        });
+        match overlap {
+            Some(cube) => Err(Error::BlocksOverlap { cube }),
+            None => Ok(out),
+        }
     }
 
     /// The whole mesh, once the shares joined cover every cube of the grid: exactly what
@@ -374,5 +388,57 @@ impl BlockMesh {
             triangles: self.triangles,
             stats: self.stats,
         })
+    }
+}
+
+/// Visits the elements of non-decreasing `lists` in order, as `visit(list, index, again)`:
+/// `again` is true for an element equal to one just visited from another list (ties within one
+/// list are plain visits). A run of one list that sorts before every other list's next element
+/// is visited without touching the heap: a block's keys come in runs of a row.
+fn merge_sorted<'a>(
+    lists: impl Iterator<Item = &'a [u64]>,
+    mut visit: impl FnMut(usize, usize, bool),
+) {
+    let lists: Vec<&[u64]> = lists.collect();
+    let mut next = alloc::vec![0usize; lists.len()];
+    let mut heads: BinaryHeap<Reverse<(u64, usize)>> = lists
+        .iter()
+        .enumerate()
+        .filter_map(|(l, list)| Some(Reverse((*list.first()?, l))))
+        .collect();
+    while let Some(Reverse((v, l))) = heads.pop() {
+        let list = lists[l];
+        let mut at = next[l];
+        // This list's elements equal to `v`, ...
+        while at < list.len() && list[at] == v {
+            visit(l, at, false);
+            at += 1;
+        }
+        // ... the other lists' (repeats), ...
+        while let Some(&Reverse((w, m))) = heads.peek()
+            && w == v
+        {
+            heads.pop();
+            let other = lists[m];
+            let mut i = next[m];
+            while i < other.len() && other[i] == v {
+                visit(m, i, true);
+                i += 1;
+            }
+            next[m] = i;
+            if let Some(&u) = other.get(i) {
+                heads.push(Reverse((u, m)));
+            }
+        }
+        // ... then the rest of this list's run, up to the next list's head.
+        let bound = heads.peek().map_or(u64::MAX, |r| r.0.0);
+        while at < list.len() && list[at] < bound {
+            visit(l, at, false);
+            at += 1;
+        }
+        next[l] = at;
+        if let Some(&u) = list.get(at) {
+            heads.push(Reverse((u, l)));
+        }
     }
 }

@@ -62,7 +62,8 @@ fn blocks(dims: [usize; 3], cuts: &[Vec<usize>; 3]) -> Vec<[Range<usize>; 3]> {
     out
 }
 
-/// Meshes every block, then joins the shares in an order and tree shape drawn from `seed`.
+/// Meshes every block, then joins the shares in an order and tree shape drawn from `seed`: each
+/// join takes two to five shares at once.
 fn joined<T: Sample>(vol: &Vol<T>, params: &Params, cuts: &[Vec<usize>; 3], seed: u64) -> Mesh {
     let mut parts: Vec<BlockMesh> = blocks(vol.dims, cuts)
         .into_iter()
@@ -71,10 +72,18 @@ fn joined<T: Sample>(vol: &Vol<T>, params: &Params, cuts: &[Vec<usize>; 3], seed
     let mut s = seed;
     while parts.len() > 1 {
         s = splitmix(s);
-        let a = parts.swap_remove(s as usize % parts.len());
-        s = splitmix(s);
-        let b = parts.swap_remove(s as usize % parts.len());
-        parts.push(a.merge(b).expect("disjoint shares"));
+        let k = (2 + s as usize % 4).min(parts.len());
+        let group: Vec<BlockMesh> = (0..k)
+            .map(|_| {
+                s = splitmix(s);
+                parts.swap_remove(s as usize % parts.len())
+            })
+            .collect();
+        let one = match <[BlockMesh; 2]>::try_from(group) {
+            Ok([a, b]) => a.merge(b),
+            Err(group) => BlockMesh::merge_all(group),
+        };
+        parts.push(one.expect("disjoint shares"));
     }
     parts.pop().expect("one").into_mesh().expect("complete")
 }
@@ -228,7 +237,14 @@ fn overlapping_or_missing_blocks_are_refused() {
     let a = share(&vol, &params, [0..19, 0..19, 0..10]);
     let b = share(&vol, &params, [0..19, 0..19, 8..19]);
     assert!(matches!(
-        a.clone().merge(b),
+        a.clone().merge(b.clone()),
+        Err(Error::BlocksOverlap { .. })
+    ));
+    // Among several shares at once, and between shares that are not next to each other in the
+    // list.
+    let top = share(&vol, &params, [0..19, 0..10, 10..19]);
+    assert!(matches!(
+        BlockMesh::merge_all([a.clone(), top, b]),
         Err(Error::BlocksOverlap { .. })
     ));
     assert!(matches!(

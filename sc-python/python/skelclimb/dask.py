@@ -45,15 +45,31 @@ def _grown(block, axes, halos, cut=None):
         index[cut[0]] = cut[1]
         return np.asarray(a[tuple(index)])
 
-    out = part(block)
-    for n, axis in enumerate(axes):
-        before, after = halos[2 * n], halos[2 * n + 1]
-        pieces = [part(before[1])] if before is not None else []
-        pieces.append(out)
+    core = part(block)
+    pieces = [(axis,
+               None if halos[2 * n] is None else part(halos[2 * n][1]),
+               None if halos[2 * n + 1] is None else part(halos[2 * n + 1][0]))
+              for n, axis in enumerate(axes)]
+    if all(before is None and after is None for _, before, after in pieces):
+        return core
+    # Written into one array, each piece once: joining axis by axis copied a chunk three times.
+    lo, shape = [0, 0, 0], list(core.shape)
+    for axis, before, after in pieces:
+        lo[axis] = 0 if before is None else before.shape[axis]
+        shape[axis] += lo[axis] + (0 if after is None else after.shape[axis])
+    out = np.empty(shape, core.dtype)
+    # The part of `out` filled so far: the whole extent along the axes done, the core's range
+    # along the others, which is what each next halo covers.
+    region = [slice(lo[d], lo[d] + core.shape[d]) for d in range(3)]
+    out[tuple(region)] = core
+    for axis, before, after in pieces:
+        if before is not None:
+            region[axis] = slice(0, lo[axis])
+            out[tuple(region)] = before
         if after is not None:
-            pieces.append(part(after[0]))
-        if len(pieces) > 1:
-            out = np.concatenate(pieces, axis=axis)
+            region[axis] = slice(lo[axis] + core.shape[axis], shape[axis])
+            out[tuple(region)] = after
+        region[axis] = slice(0, shape[axis])
     return out
 
 
