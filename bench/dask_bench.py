@@ -14,6 +14,8 @@ plus ``dask[array] distributed zarr``.
 
 With ``--shards`` the workers write one shard per chunk instead of returning shares, and the
 mesh is joined afterwards with ``skelclimb.merge_shards`` (its time and memory go to stderr).
+With ``--null-graph`` the cluster then also runs a graph of the same shape whose tasks do
+nothing: what Dask itself costs for that many tasks on this machine.
 """
 
 import argparse
@@ -84,7 +86,26 @@ def run_single(path, level):
                       "triangles": int(mesh.faces.shape[0])}))
 
 
-def run_cluster(path, level, workers, shards=None):
+def _nothing(*dependencies):
+    return np.zeros(4, np.uint8)
+
+
+def null_graph_seconds(client, arr, level):
+    """The time of ``skelclimb.dask.extract``'s graph for ``arr`` with every task (the array's
+    own chunk loads included) replaced by one that returns four bytes: Dask's cost alone."""
+    import dask.core
+
+    import skelclimb.dask
+
+    delayed = skelclimb.dask.extract(arr, level, normals=False, compute=False)
+    graph = dict(delayed.__dask_graph__())
+    null = {k: (_nothing, *dask.core.get_dependencies(graph, k)) for k in graph}
+    t = time.perf_counter()
+    client.get(null, [delayed.key])
+    return time.perf_counter() - t
+
+
+def run_cluster(path, level, workers, shards=None, null=False):
     import dask.array as da
     import distributed
 
@@ -101,6 +122,7 @@ def run_cluster(path, level, workers, shards=None):
         result = skelclimb.dask.extract(arr, level, normals=False, shards=shards)
         seconds = time.perf_counter() - t
         peaks = sorted(client.run(peak_rss_mib).values())
+        null_seconds = null_graph_seconds(client, arr, level) if null else None
     if shards is not None:
         # Joined here, on "a machine that can hold the result", after the cluster is gone.
         t = time.perf_counter()
@@ -112,7 +134,7 @@ def run_cluster(path, level, workers, shards=None):
     same = (np.array_equal(mesh.faces, np.load(path + ".single-faces.npy"))
             and np.array_equal(mesh.vertices, np.load(path + ".single-verts.npy")))
     mesh_mib = (mesh.faces.nbytes + mesh.vertices.nbytes) / 2**20
-    return seconds, idle, peaks, same, int(mesh.faces.shape[0]), mesh_mib
+    return seconds, idle, peaks, same, int(mesh.faces.shape[0]), mesh_mib, null_seconds
 
 
 def main():
@@ -124,6 +146,8 @@ def main():
     p.add_argument("--dir", default="/tmp/skelclimb-dask")
     p.add_argument("--shards", action="store_true",
                    help="workers write shards (in DIR/shards) instead of returning shares")
+    p.add_argument("--null-graph", action="store_true",
+                   help="also time the same graph with tasks that do nothing")
     p.add_argument("--single", action="store_true", help=argparse.SUPPRESS)
     a = p.parse_args()
     path = os.path.join(a.dir, f"balls{a.size}-c{a.chunk}.zarr")
@@ -136,7 +160,8 @@ def main():
          "--level", str(a.level), "--dir", a.dir],
         check=True, capture_output=True, text=True).stdout)
     shards = os.path.join(a.dir, "shards") if a.shards else None
-    seconds, idle, peaks, same, triangles, mesh_mib = run_cluster(path, a.level, a.workers, shards)
+    seconds, idle, peaks, same, triangles, mesh_mib, null_seconds = run_cluster(
+        path, a.level, a.workers, shards, a.null_graph)
     gib = a.size**3 / 2**30
     print(f"| run | wall time | time × cores / single | peak RSS per process |")
     print(f"|---|---|---|---|")
@@ -146,6 +171,9 @@ def main():
     print(f"| LocalCluster, {a.workers} processes{how} | {seconds:.1f} s | "
           f"{seconds * a.workers / single['seconds']:.2f} | "
           f"{', '.join(f'{m:.0f}' for m in peaks)} MiB |")
+    if null_seconds is not None:
+        print(f"| LocalCluster, the same graph with no-op tasks | {null_seconds:.1f} s | "
+              f"{null_seconds * a.workers / single['seconds']:.2f} | – |")
     print(f"\n{a.size}³ uint8 ({gib:.2f} GiB) in {a.chunk}³ chunks, level {a.level:g}: "
           f"{triangles:,} triangles ({mesh_mib:.0f} MiB of vertices and faces); "
           f"meshes identical: {same}; idle workers before the run: "
