@@ -145,7 +145,7 @@ def test_dask_tasks_are_prioritised_by_z_layer():
                 name = key if isinstance(key, str) else key[0]
                 priorities.setdefault(name.rsplit("-", 1)[0], set()).add(value)
     assert priorities.get("skelclimb-block") == {0, -1, -2, -3}
-    assert priorities.get("skelclimb-halo") == {0, -1, -2, -3}
+    assert priorities.get("skelclimb-shell") == {0, -1, -2, -3}
 
 
 def _die_once(block, marker):

@@ -32,83 +32,52 @@ __all__ = ["extract"]
 _AFTER = 3
 
 
-def _grown(block, axes, halos, cut=None):
-    """``block`` extended along each of ``axes`` in turn by ``halos``, a flat sequence of
-    ``before, after`` pairs, one pair per axis: the slabs of the neighbouring blocks along that
-    axis (each already extended along the axes before it), ``None`` at the grid's ends. With
-    ``cut = (axis, slice)``, only that slice along another axis is built: cutting before joining
-    keeps the copy small."""
-    def part(a):
-        if cut is None:
-            return np.asarray(a)
-        index = [slice(None)] * 3
-        index[cut[0]] = cut[1]
-        return np.asarray(a[tuple(index)])
+# A neighbour's place relative to a block, per axis (z, y, x): -1 before it, +1 after it.
+_OFFSETS = [tuple(c - 1 for c in o) for o in np.ndindex(3, 3, 3) if o != (1, 1, 1)]
 
-    core = part(block)
-    pieces = [(axis,
-               None if halos[2 * n] is None else part(halos[2 * n][1]),
-               None if halos[2 * n + 1] is None else part(halos[2 * n + 1][0]))
-              for n, axis in enumerate(axes)]
-    if all(before is None and after is None for _, before, after in pieces):
+# What a block needs of a neighbour along an axis where the neighbour lies before it (its last
+# sample), level with it (all of it), or after it (its first _AFTER samples).
+_PICK = {-1: slice(-1, None), 0: slice(None), 1: slice(0, _AFTER)}
+
+
+def _shell(block):
+    """The pieces of ``block`` its 26 neighbours read, one per offset in ``_OFFSETS`` (the
+    offset at which the reading block sees this one): thin faces, edges and corners, copied so
+    that they do not keep the chunk alive."""
+    b = np.asarray(block)
+    return [b[tuple(_PICK[c] for c in o)].copy() for o in _OFFSETS]
+
+
+def _extended(block, shells):
+    """``block`` with its halo, in one array: ``shells`` holds, per offset in ``_OFFSETS``, that
+    neighbour's :func:`_shell` (``None`` past the grid's ends); each piece is copied once."""
+    core = np.asarray(block)
+    pieces = {o: s[n] for n, (o, s) in enumerate(zip(_OFFSETS, shells)) if s is not None}
+    if not pieces:
         return core
-    # Written into one array, each piece once: joining axis by axis copied a chunk three times.
-    lo, shape = [0, 0, 0], list(core.shape)
-    for axis, before, after in pieces:
-        lo[axis] = 0 if before is None else before.shape[axis]
-        shape[axis] += lo[axis] + (0 if after is None else after.shape[axis])
-    out = np.empty(shape, core.dtype)
-    # The part of `out` filled so far: the whole extent along the axes done, the core's range
-    # along the others, which is what each next halo covers.
-    region = [slice(lo[d], lo[d] + core.shape[d]) for d in range(3)]
-    out[tuple(region)] = core
-    for axis, before, after in pieces:
-        if before is not None:
-            region[axis] = slice(0, lo[axis])
-            out[tuple(region)] = before
-        if after is not None:
-            region[axis] = slice(lo[axis] + core.shape[axis], shape[axis])
-            out[tuple(region)] = after
-        region[axis] = slice(0, shape[axis])
+
+    def thickness(axis, side):
+        piece = pieces.get(tuple(side if d == axis else 0 for d in range(3)))
+        return 0 if piece is None else piece.shape[axis]
+
+    # Per axis, the samples from the neighbour before, the chunk's, the neighbour after's.
+    sizes = [(thickness(a, -1), core.shape[a], thickness(a, 1)) for a in range(3)]
+    out = np.empty([sum(n) for n in sizes], core.dtype)
+
+    def region(offset):
+        """Where the piece of the neighbour at ``offset`` (``(0, 0, 0)``: the chunk) goes."""
+        return tuple(slice(sum(n[:side + 1]), sum(n[:side + 2]))
+                     for n, side in zip(sizes, offset))
+
+    out[region((0, 0, 0))] = core
+    for offset, piece in pieces.items():
+        out[region(offset)] = piece
     return out
 
 
-def _slabs(block, axis, axes, *halos):
-    """What ``block``'s neighbours along ``axis`` need of it, extended along ``axes`` by
-    ``halos``: its first ``_AFTER`` samples (for the block before) and its last one (for the
-    block after)."""
-    return (_grown(block, axes, halos, (axis, slice(0, _AFTER))),
-            _grown(block, axes, halos, (axis, slice(-1, None))))
-
-
-def _halos(chunks, shape, name):
-    """The tasks that give each block its halos along x, then y, then z: one slab task per block
-    and axis, fed by the halos before it, so that the edge and corner samples come along. Only
-    the chunks themselves and thin slabs are ever held, never extended copies, and only the
-    slabs travel between workers.
-
-    ``chunks`` maps a block's index ``(iz, iy, ix)`` to its chunk's key. Returns the slab tasks
-    (a graph: key to task) and, per block index, the axes its halos extend and the flat
-    ``before, after`` keys along each (``None`` at the grid's ends)."""
-    tasks = {}
-    axes = tuple(a for a in (2, 1, 0) if shape[a] > 1)
-    halos = {idx: [] for idx in np.ndindex(shape)}
-    for n, axis in enumerate(axes):
-        for idx in np.ndindex(shape):
-            tasks[(name, axis) + idx] = (_slabs, chunks[idx], axis, axes[:n], *halos[idx])
-        step = tuple(int(a == axis) for a in range(3))
-        for idx in np.ndindex(shape):
-            i = idx[axis]
-            before = (name, axis) + tuple(c - s for c, s in zip(idx, step)) if i > 0 else None
-            after = (name, axis) + tuple(c + s for c, s in zip(idx, step)) \
-                if i + 1 < shape[axis] else None
-            halos[idx].extend((before, after))
-    return tasks, axes, halos
-
-
-def _mesh(block, axes, at, grid, cubes, options, *halos):
-    """Meshes a block from its chunk and its halos."""
-    return extract_block(_grown(block, axes, halos), at=at, grid=grid, cubes=cubes, **options)
+def _mesh(block, at, grid, cubes, options, *shells):
+    """Meshes a block from its chunk and its neighbours' shells."""
+    return extract_block(_extended(block, shells), at=at, grid=grid, cubes=cubes, **options)
 
 
 def _native_settings(options):
@@ -119,10 +88,10 @@ def _native_settings(options):
             bool(options["normals"]), _bound(options["max_error"], options["error_units"]))
 
 
-def _shard(directory, block, axes, at, grid, cubes, options, *halos):
+def _shard(directory, block, at, grid, cubes, options, *shells):
     """Meshes one block and writes it as a shard; returns only the manifest's small record, so
     the worker keeps no mesh."""
-    share = _mesh(block, axes, at, grid, cubes, options, *halos)
+    share = _mesh(block, at, grid, cubes, options, *shells)
     return _native.write_shard(share._share, directory, cubes, _native_settings(options))
 
 
@@ -225,9 +194,9 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     _bound(max_error, error_units)
     options = dict(level=level, spacing=spacing, origin=origin, mode=mode, normals=normals,
                    max_error=max_error, error_units=error_units)
-    # Each task gets its chunk plus the halo extract_block reads (one sample before, up to
-    # three after), as thin slabs from its neighbours, built one axis at a time (see _halos):
-    # about five tasks per chunk where dask.array.overlap makes some 24, every chunk read once.
+    # Each block's task gets its chunk plus the halo extract_block reads (one sample before, up
+    # to three after), cut from its 26 neighbours' shells (see _shell): three tasks per chunk
+    # (read, shell, mesh) where dask.array.overlap makes some 24, and every chunk read once.
     array = array.rechunk(tuple(_at_least(c, _AFTER) for c in array.chunks))
     # The graph is written out here, task by task, rather than by calling dask.delayed
     # functions: each such call merges and culls its arguments' graphs, which took 1.75 s for
@@ -237,7 +206,15 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     chunks = {idx: keys[idx[0]][idx[1]][idx[2]] for idx in np.ndindex(shape)}
     directory = None if shards is None else os.fspath(shards)
     token = tokenize(array.name, options, split_every, directory)
-    blocks, axes, halos = _halos(chunks, shape, "skelclimb-halo-" + token)
+    shell = "skelclimb-shell-" + token
+    blocks = {}
+    if shape != (1, 1, 1):
+        blocks = {(shell, *idx): (_shell, chunks[idx]) for idx in np.ndindex(shape)}
+
+    def shells(idx):
+        near = [tuple(i + c for i, c in zip(idx, o)) for o in _OFFSETS]
+        return [(shell, *n) if all(0 <= i < m for i, m in zip(n, shape)) else None for n in near]
+
     name = "skelclimb-block-" + token
     if directory is not None:
         os.makedirs(directory, exist_ok=True)
@@ -251,7 +228,7 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
                 cubes = (cx, cy, cz)
                 at = tuple(max(c[0] - 1, 0) for c in cubes)
                 idx = (iz, iy, ix)
-                task = (chunks[idx], axes, at, grid, cubes, options, *halos[idx])
+                task = (chunks[idx], at, grid, cubes, options, *shells(idx))
                 key = (name, *idx)
                 blocks[key] = (_mesh, *task) if directory is None else (_shard, directory, *task)
                 shares.append(key)
@@ -294,6 +271,6 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
 
 
 def _by_z_layer(key):
-    """A block's or a halo slab's priority: its z layer's index, negated (Dask runs higher
+    """A block's or a shell's priority: its z layer's index, negated (Dask runs higher
     priorities first). The layer's index is third from the end of every such key."""
     return -key[-3]
