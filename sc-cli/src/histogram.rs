@@ -113,7 +113,7 @@ impl Histogram {
     /// histogram that are lower than both neighbours and at most half the smaller of the highest
     /// peaks on each side. Smoothing over 7 bins bridges the empty bins of quantised data (CT
     /// values in steps of 62.5, say), which would otherwise look like valleys. A peak must hold
-    /// [`PEAK_SHARE`] of the samples, so that a few saturated values at the top of the range do
+    /// `PEAK_SHARE` of the samples, so that a few saturated values at the top of the range do
     /// not make a "tissue"; one valley is kept per pair of peaks, since two minima between the
     /// same peaks separate the same two things.
     pub fn valleys(&self, max: usize) -> Vec<(f64, f64, f64)> {

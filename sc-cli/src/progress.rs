@@ -20,7 +20,7 @@ pub struct Bar {
 }
 
 impl Bar {
-    /// A bar that shows itself after [`SHOW_AFTER`] if `enabled` and stderr is a terminal.
+    /// A bar that shows itself after `SHOW_AFTER` if `enabled` and stderr is a terminal.
     pub fn new(enabled: bool) -> Self {
         let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
         if let Ok(style) = ProgressStyle::with_template(

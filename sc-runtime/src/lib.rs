@@ -1,6 +1,6 @@
 //! Skeleton Climbing isosurface extraction.
 //!
-//! The core ([`sweep`]) is `no_std` and allocation-free: it walks a grid layer by layer with
+//! The core (the layer sweep) is `no_std` and allocation-free: it walks a grid layer by layer with
 //! O(nx·ny) caller-provided scratch and hands vertices and triangles to a [`Sink`]. With the
 //! `alloc` feature, [`extract`] builds an indexed [`Mesh`] and [`SliceStreamer`] meshes a volume
 //! fed one z-slice at a time; with `std` (default), [`extract_par`] splits the z range over threads
