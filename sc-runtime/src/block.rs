@@ -393,7 +393,7 @@ impl BlockMesh {
 
 /// Visits the elements of non-decreasing `lists` in order, as `visit(list, index, again)`:
 /// `again` is true for an element equal to one just visited from another list (ties within one
-/// list are plain visits). A run of one list that sorts before every other list's next element
+/// list are plain visits, after the other lists' repeats). A run of one list that sorts before every other list's next element
 /// is visited without touching the heap: a block's keys come in runs of a row.
 fn merge_sorted<'a>(
     lists: impl Iterator<Item = &'a [u64]>,
@@ -408,13 +408,10 @@ fn merge_sorted<'a>(
         .collect();
     while let Some(Reverse((v, l))) = heads.pop() {
         let list = lists[l];
-        let mut at = next[l];
-        // This list's elements equal to `v`, ...
-        while at < list.len() && list[at] == v {
-            visit(l, at, false);
-            at += 1;
-        }
-        // ... the other lists' (repeats), ...
+        // This list's head, ...
+        visit(l, next[l], false);
+        let mut at = next[l] + 1;
+        // ... the other lists' elements equal to it (repeats), ...
         while let Some(&Reverse((w, m))) = heads.peek()
             && w == v
         {
@@ -430,7 +427,8 @@ fn merge_sorted<'a>(
                 heads.push(Reverse((u, m)));
             }
         }
-        // ... then the rest of this list's run, up to the next list's head.
+        // ... then the rest of this list's run (its own ties included), up to the next list's
+        // head, which the repeats left above `v`.
         let bound = heads.peek().map_or(u64::MAX, |r| r.0.0);
         while at < list.len() && list[at] < bound {
             visit(l, at, false);
