@@ -473,7 +473,7 @@ impl Out<'_> {
             });
             let normal = params
                 .normals
-                .then(|| field.normal(p, AXIS, t, grid.is_filled(p)));
+                .then(|| field.normal::<AXIS>(p, t, grid.is_filled(p)));
             sink.edge_vertex(global, AXIS, pos, normal);
         }
         Ok(id)
