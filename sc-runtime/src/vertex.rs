@@ -155,6 +155,9 @@ impl<T: Scalar> Field<'_, T> {
 
     /// The outward unit normal at `t` along the edge from `p` along `AXIS`: the negated,
     /// interpolated gradient, or the edge direction where the gradient vanishes or is NaN.
+    /// Inlined into each vertex pass: as a call it spilled the pass's registers, and brainsmall's
+    /// normals cost 10 % more time.
+    #[inline(always)]
     pub fn normal<const AXIS: usize>(&self, p: [usize; 3], t: f64, a_filled: bool) -> [f32; 3] {
         let (ga, gb) = self.interior_pair::<AXIS>(p).unwrap_or_else(|| {
             let mut q = p;
