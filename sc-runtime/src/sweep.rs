@@ -785,7 +785,9 @@ fn crossed(cases: &[u8], start: usize, end: usize) -> impl Iterator<Item = (usiz
 }
 
 /// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing eight
-/// bytes at a time: most of a row's span is unchanged, and a vertex is the rare event.
+/// bytes at a time: most of a row's span is unchanged, and a vertex is the rare event. The short
+/// tail is folded into the same mask loop, so that `f` has one call site and is inlined: called
+/// out of line, once per vertex, it cost a fifth of the vertex passes.
 #[inline]
 fn for_each_differing(
     a: &[u8],
@@ -795,20 +797,20 @@ fn for_each_differing(
     mut f: impl FnMut(usize) -> Result<(), Error>,
 ) -> Result<(), Error> {
     let mut x = start;
-    while x + 8 <= end {
-        let word = |r: &[u8]| u64::from_le_bytes(r[x..x + 8].try_into().expect("eight bytes"));
-        let mut diff = word(a) ^ word(b);
+    while x < end {
+        let n = (end - x).min(8);
+        let mut diff = if n == 8 {
+            let word = |r: &[u8]| u64::from_le_bytes(r[x..x + 8].try_into().expect("eight bytes"));
+            word(a) ^ word(b)
+        } else {
+            (0..n).fold(0, |m, i| m | u64::from(a[x + i] != b[x + i]) << (8 * i))
+        };
         while diff != 0 {
             let byte = diff.trailing_zeros() as usize / 8;
             f(x + byte)?;
             diff &= !(0xFF << (8 * byte));
         }
-        x += 8;
-    }
-    for x in x..end {
-        if a[x] != b[x] {
-            f(x)?;
-        }
+        x += n;
     }
     Ok(())
 }
