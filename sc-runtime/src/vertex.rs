@@ -108,13 +108,14 @@ impl<T: Scalar> Field<'_, T> {
         let [nx, ny, nz] = self.dims;
         let inside =
             |c: usize, n: usize, axis: usize| c >= 1 && c + 1 + usize::from(axis == AXIS) < n;
-        if !(inside(x, nx, 0) && inside(y, ny, 1) && inside(z, nz, 2)) {
+        // A pass's field starts one slice below the pass's `z` (see `Sweep::field`), so the
+        // four slices are in place: no per-vertex lookup.
+        if !(inside(x, nx, 0) && inside(y, ny, 1) && inside(z, nz, 2) && z == self.first + 1) {
             return None;
         }
         let i = nx * y + x;
         let d = |a: T, b: T, axis: usize| (b.to_f64() - a.to_f64()) * self.steps[axis][1];
-        let here = self.slice(z);
-        let (below, above) = (self.slice(z - 1), self.slice(z + 1));
+        let [below, here, above, top] = self.slices;
         Some(match AXIS {
             0 => {
                 let r = &here[i - 1..i + 3];
@@ -135,7 +136,6 @@ impl<T: Scalar> Field<'_, T> {
                 )
             }
             _ => {
-                let top = self.slice(z + 2);
                 let (r, q) = (&here[i - nx..i + nx + 1], &above[i - nx..i + nx + 1]);
                 (
                     [
@@ -168,7 +168,8 @@ impl<T: Scalar> Field<'_, T> {
         // The test reads the squared length, not its root: a branch on the root would wait for
         // the square root's long latency, and that wait was a quarter of what normals cost.
         let squared = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if squared > 0.0 && squared.is_finite() {
+        // Positive and finite; NaN fails both tests.
+        if squared > 0.0 && squared < f64::INFINITY {
             let inv = 1.0 / libm::sqrt(squared);
             g.map(|c| (c * inv) as f32)
         } else {
