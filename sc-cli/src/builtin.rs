@@ -19,7 +19,7 @@ pub fn grid(which: Demo, n: usize) -> (Grid, f64) {
         Demo::Torus => demo::torus(n),
         Demo::SphereNoise => demo::sphere_noise(n),
     };
-    let mut grid = Grid::new(Samples::F64(data), dims, "built-in");
+    let mut grid = Grid::new(Samples::F64(data.into()), dims, "built-in");
     grid.spacing = spacing;
     grid.origin = origin;
     (grid, iso)

@@ -176,7 +176,7 @@ mod tests {
 
     fn grid(values: Vec<u8>) -> Grid {
         let n = values.len();
-        Grid::new(Samples::U8(values), [n, 1, 1], "test")
+        Grid::new(Samples::U8(values.into()), [n, 1, 1], "test")
     }
 
     #[test]
@@ -230,7 +230,7 @@ mod tests {
     #[test]
     fn extreme_values_stay_finite() {
         let v = vec![-1.7e308, 1.7e308, 0.0, 1.0];
-        let g = Grid::new(Samples::F64(v), [4, 1, 1], "test");
+        let g = Grid::new(Samples::F64(v.into()), [4, 1, 1], "test");
         let h = Histogram::of(&g, &g.range(), 16);
         assert_eq!(h.counts.iter().sum::<u64>(), 4);
         assert!(h.mean.is_finite());

@@ -15,6 +15,7 @@
 //! ```
 
 pub mod atomic;
+pub mod buffer;
 pub mod error;
 pub mod mesh_in;
 pub mod progress;

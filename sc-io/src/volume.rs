@@ -2,6 +2,8 @@
 //! costs 256 MiB and not 1 GiB, and the extractor compares integers exactly.
 
 use bytemuck::Pod;
+
+pub use crate::buffer::Buffer;
 use sc_runtime::Scalar;
 
 use crate::space::Frame;
@@ -107,28 +109,28 @@ impl Endian {
     }
 }
 
-/// Samples in their stored type, x fastest.
+/// Samples in their stored type, x fastest, in memory or mapped from their file.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Samples {
     /// `u8` samples.
-    U8(Vec<u8>),
+    U8(Buffer<u8>),
     /// `i8` samples.
-    I8(Vec<i8>),
+    I8(Buffer<i8>),
     /// `u16` samples.
-    U16(Vec<u16>),
+    U16(Buffer<u16>),
     /// `i16` samples.
-    I16(Vec<i16>),
+    I16(Buffer<i16>),
     /// `u32` samples.
-    U32(Vec<u32>),
+    U32(Buffer<u32>),
     /// `i32` samples.
-    I32(Vec<i32>),
+    I32(Buffer<i32>),
     /// `f32` samples.
-    F32(Vec<f32>),
+    F32(Buffer<f32>),
     /// `f64` samples.
-    F64(Vec<f64>),
+    F64(Buffer<f64>),
 }
 
-/// Runs `$body` with `$v` bound to the typed `Vec` inside a [`Samples`], so that generic code is
+/// Runs `$body` with `$v` bound to the typed [`Buffer`] inside a [`Samples`], so that generic code is
 /// written once and monomorphised per type.
 #[macro_export]
 macro_rules! with_samples {
@@ -205,7 +207,7 @@ impl Samples {
 
     /// No samples, of type `dtype`: a grid whose samples are read later, or slice by slice.
     pub fn empty(dtype: Dtype) -> Samples {
-        crate::with_dtype!(dtype, T => T::wrap(Vec::new()))
+        crate::with_dtype!(dtype, T => T::wrap(Vec::new().into()))
     }
 }
 
@@ -217,8 +219,8 @@ fn dtype_of<T: Sample>(_: &[T]) -> Dtype {
 pub trait Sample: Scalar + Pod + PartialOrd + zarrs::array::ElementOwned {
     /// The matching [`Dtype`].
     const DTYPE: Dtype;
-    /// Wraps a typed vector.
-    fn wrap(v: Vec<Self>) -> Samples;
+    /// Wraps typed samples.
+    fn wrap(v: Buffer<Self>) -> Samples;
     /// The largest value of this type that is empty at `iso` (`< iso`), if the type has one.
     fn largest_below(iso: f64) -> Option<Self>;
 }
@@ -227,7 +229,7 @@ macro_rules! int_sample {
     ($($t:ty => $d:ident),*) => {$(
         impl Sample for $t {
             const DTYPE: Dtype = Dtype::$d;
-            fn wrap(v: Vec<Self>) -> Samples {
+            fn wrap(v: Buffer<Self>) -> Samples {
                 Samples::$d(v)
             }
             fn largest_below(iso: f64) -> Option<Self> {
@@ -242,7 +244,7 @@ int_sample!(u8 => U8, i8 => I8, u16 => U16, i16 => I16, u32 => U32, i32 => I32);
 
 impl Sample for f32 {
     const DTYPE: Dtype = Dtype::F32;
-    fn wrap(v: Vec<Self>) -> Samples {
+    fn wrap(v: Buffer<Self>) -> Samples {
         Samples::F32(v)
     }
     fn largest_below(iso: f64) -> Option<Self> {
@@ -254,7 +256,7 @@ impl Sample for f32 {
 
 impl Sample for f64 {
     const DTYPE: Dtype = Dtype::F64;
-    fn wrap(v: Vec<Self>) -> Samples {
+    fn wrap(v: Buffer<Self>) -> Samples {
         Samples::F64(v)
     }
     fn largest_below(iso: f64) -> Option<Self> {
@@ -381,7 +383,7 @@ impl Grid {
         self.samples = with_samples!(&self.samples, v => {
             let fill = pad_value(v, stored_iso)
                 .ok_or_else(|| format!("--pad: no {} value is below iso {iso}", dtype.name()))?;
-            Sample::wrap(padded(v, dims, fill))
+            Sample::wrap(padded(v, dims, fill).into())
         });
         self.dims = dims.map(|d| d + 2);
         // One sample back along each axis, in world space.

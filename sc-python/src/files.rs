@@ -150,8 +150,7 @@ pub fn load<'py>(
     } else {
         with_samples!(&samples, v => rescaled(v, scale))
     };
-    let volume =
-        with_samples!(samples, v => PyArray1::from_vec(py, v).reshape([nz, ny, nx])?.into_any());
+    let volume = with_samples!(samples, v => PyArray1::from_vec(py, v.into_vec()).reshape([nz, ny, nx])?.into_any());
     (volume, spacing, origin).into_pyobject(py)
 }
 

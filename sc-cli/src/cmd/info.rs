@@ -244,7 +244,11 @@ mod tests {
 
     fn report(values: Vec<i16>) -> String {
         let n = values.len();
-        describe("t", &Grid::new(Samples::I16(values), [n, 1, 1], "test"), 16)
+        describe(
+            "t",
+            &Grid::new(Samples::I16(values.into()), [n, 1, 1], "test"),
+            16,
+        )
     }
 
     #[test]

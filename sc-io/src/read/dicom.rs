@@ -202,8 +202,7 @@ pub fn read(dir: &Path, choice: &DicomOptions, progress: &dyn Progress) -> Resul
     };
     let options = ConvertOptions::new().with_modality_lut(lut);
     progress.phase("reading", slices.len() as u64);
-    let samples =
-        with_dtype!(dtype, T => decode_all::<T>(&slices, &options, progress).map(Sample::wrap))?;
+    let samples = with_dtype!(dtype, T => decode_all::<T>(&slices, &options, progress).map(|v| Sample::wrap(v.into())))?;
 
     let mut grid = Grid::new(samples, dims, "DICOM series");
     if same_rescale {
@@ -456,7 +455,7 @@ fn resample(grid: &Grid, depths: &[f64], dz: f64) -> Grid {
     let samples = if grid.samples.dtype().size() <= 2 {
         Samples::F32(out.iter().map(|&v| v as f32).collect())
     } else {
-        Samples::F64(out)
+        Samples::F64(out.into())
     };
     let mut resampled = Grid::new(samples, [nx, ny, nz], grid.format);
     resampled.scale = grid.scale;

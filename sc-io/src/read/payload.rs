@@ -70,7 +70,7 @@ pub fn read_samples(
     verified: bool,
     progress: &dyn Progress,
 ) -> io::Result<Samples> {
-    with_dtype!(layout.dtype, T => read_typed::<T>(reader, layout, verified, progress).map(Sample::wrap))
+    with_dtype!(layout.dtype, T => read_typed::<T>(reader, layout, verified, progress).map(|v| Sample::wrap(v.into())))
 }
 
 /// Chunk size for progress updates: large enough that the bar costs nothing.
@@ -172,7 +172,7 @@ mod tests {
     fn big_endian_is_swapped() {
         let bytes = [0x01, 0x02, 0xff, 0xfe];
         let s = read(&bytes, Encoding::Raw, Dtype::I16, Endian::Big, 2);
-        assert_eq!(s.unwrap(), Samples::I16(vec![0x0102, -2]));
+        assert_eq!(s.unwrap(), Samples::I16(vec![0x0102, -2].into()));
     }
 
     #[test]
@@ -182,7 +182,7 @@ mod tests {
         gz.write_all(&data).unwrap();
         let gz = gz.finish().unwrap();
         let s = read(&gz, Encoding::Gzip, Dtype::U8, Endian::Little, 256);
-        assert_eq!(s.unwrap(), Samples::U8(data));
+        assert_eq!(s.unwrap(), Samples::U8(data.into()));
     }
 
     #[test]

@@ -153,7 +153,7 @@ impl Stream {
                 all.extend(self.read::<T>(slab)?);
                 progress.inc((self.read - before) as u64);
             }
-            T::wrap(all)
+            T::wrap(all.into())
         });
         self.grid.samples = samples;
         Ok(self.grid)
