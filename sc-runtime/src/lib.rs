@@ -34,6 +34,8 @@ pub use mesh::{Mesh, extract};
 #[cfg(feature = "alloc")]
 mod block;
 #[cfg(feature = "alloc")]
+mod survey;
+#[cfg(feature = "alloc")]
 pub use block::{BlockMesh, block_samples, edge_key, extract_block};
 
 mod extract;

@@ -1,6 +1,8 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use crate::extract::{InMemory, has_cubes};
+use crate::survey::Survey;
 use crate::{Error, Params, Scalar, Scratch, Sink, Stats, Volume, extract_into};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
@@ -14,6 +16,21 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// Counts before and after merging.
     pub stats: Stats,
+}
+
+impl Mesh {
+    /// Reserves room for a surface of about `vertices` Steps 1–3 vertices (a [`Survey`]
+    /// estimate), with a margin, so that the buffers are allocated once: untouched reserved pages
+    /// cost address space, not memory.
+    pub(crate) fn reserve_for(&mut self, vertices: usize, normals: bool) {
+        let v = vertices + vertices / 4;
+        self.positions.reserve_exact(v);
+        if normals {
+            self.normals.reserve_exact(v);
+        }
+        // A closed surface has about two triangles per vertex before merging.
+        self.triangles.reserve_exact(2 * v);
+    }
 }
 
 impl Sink for Mesh {
@@ -80,8 +97,17 @@ impl OwnedScratch {
 /// assert_eq!(mesh.stats.t13, 13_968); // the paper's Table 1, Steps 1–3
 /// ```
 pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
-    let mut scratch = OwnedScratch::new(volume.dims())?;
+    let dims = volume.dims();
+    let mut scratch = OwnedScratch::new(dims)?;
     let mut mesh = Mesh::default();
+    if has_cubes(dims) {
+        let src = InMemory {
+            data: volume.data(),
+            nxy: dims[0] * dims[1],
+        };
+        let survey = Survey::new(&src, dims, T::threshold(params.iso));
+        mesh.reserve_for(survey.between(0, dims[2]), params.normals);
+    }
     mesh.stats = extract_into(volume, params, scratch.lend(), &mut mesh)?;
     Ok(mesh)
 }

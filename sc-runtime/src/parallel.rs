@@ -5,7 +5,8 @@ use rayon::prelude::*;
 
 use crate::extract::{InMemory, has_cubes};
 use crate::mesh::OwnedScratch;
-use crate::sweep::{Slices, Sweep};
+use crate::survey::{self, Survey};
+use crate::sweep::Sweep;
 use crate::{Error, Mesh, Params, Scalar, Stats, Volume};
 
 /// Layers per chunk at least: a chunk re-reads up to three slices of its neighbour, so tiny
@@ -71,7 +72,18 @@ pub fn extract_par<T: Scalar>(
         data: volume.data(),
         nxy: dims[0] * dims[1],
     };
-    let bounds = balanced_bounds(&src, dims, T::threshold(params.iso), chunks);
+    let threshold = T::threshold(params.iso);
+    let survey = Survey::from_sampled(
+        (0..dims[2])
+            .step_by(survey::STEP)
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map_init(Vec::new, |signs, &z| {
+                survey::sampled_slice(&src, dims, threshold, z, signs)
+            })
+            .collect(),
+    );
+    let bounds = balanced_bounds(&survey, dims, chunks);
     let run = || {
         let parts: Vec<Result<Part, Error>> = bounds
             .par_iter()
@@ -81,6 +93,7 @@ pub fn extract_par<T: Scalar>(
                 |scratch, &(z0, z1)| {
                     let scratch = scratch.as_mut().map_err(|e| e.clone())?;
                     let mut mesh = Mesh::default();
+                    mesh.reserve_for(survey.between(z0, z1 + 1), params.normals);
                     let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
                     sweep.start(z0, &src, &mut mesh, z0 == 0)?;
                     let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
@@ -101,47 +114,18 @@ pub fn extract_par<T: Scalar>(
     }
 }
 
-/// Rows and slices between the samples of [`balanced_bounds`]' estimate.
-const SAMPLE_STEP: usize = 4;
+/// What one estimated vertex costs, in units of one sample's fixed cost (classifying it, its
+/// cube's case, scanning its row): some hundred times more (`bench/profile.sh`).
+const VERTEX_WEIGHT: usize = 100;
 
-/// What one sampled crossing costs, in units of one sample's fixed cost: it stands for about
-/// `3 · SAMPLE_STEP` vertices of its layer (three axes, the rows skipped), each of which costs
-/// some hundred times what classifying a sample does (`bench/profile.sh`).
-const CROSSING_WEIGHT: usize = 1000;
-
-/// Cuts the z layers into `chunks` runs of about equal work. A layer's work is its samples plus
-/// its surface, estimated from the sign changes along every fourth row of every fourth slice: a
-/// sixteenth of the volume, read in a small fraction of the extraction's time. Equal ranges of
-/// layers left one thread meshing the MNI brain's white matter band alone (a chunk with half the
-/// triangles), and two threads were no faster than one.
-fn balanced_bounds<T: Scalar>(
-    src: &InMemory<'_, T>,
-    dims: [usize; 3],
-    threshold: T::Threshold,
-    chunks: usize,
-) -> Vec<(usize, usize)> {
+/// Cuts the z layers into `chunks` runs of about equal work: a layer's samples plus its
+/// surface, as the survey estimates it. Equal ranges of layers left one thread meshing the MNI
+/// brain's white matter band alone (a chunk with half the triangles), and two threads were no
+/// faster than one.
+fn balanced_bounds(survey: &Survey, dims: [usize; 3], chunks: usize) -> Vec<(usize, usize)> {
     let [nx, ny, nz] = dims;
     let layers = nz - 1;
-    let crossings: Vec<usize> = (0..nz)
-        .step_by(SAMPLE_STEP)
-        .collect::<Vec<_>>()
-        .par_iter()
-        .map_init(
-            || vec![0u8; nx],
-            |signs, &z| {
-                let slice = src.slice(z);
-                (0..ny)
-                    .step_by(SAMPLE_STEP)
-                    .map(|y| {
-                        // Classified first, so that both loops vectorise.
-                        T::classify_row(&slice[y * nx..][..nx], threshold, signs);
-                        signs.windows(2).filter(|w| w[0] != w[1]).count()
-                    })
-                    .sum()
-            },
-        )
-        .collect();
-    let cost = |k: usize| nx * ny + CROSSING_WEIGHT * crossings[k / SAMPLE_STEP];
+    let cost = |k: usize| nx * ny + VERTEX_WEIGHT * survey.at(k);
     let total: usize = (0..layers).map(cost).sum();
     let mut bounds = Vec::with_capacity(chunks);
     let (mut start, mut done) = (0, 0);
@@ -203,8 +187,10 @@ fn stitch(parts: Vec<Part>) -> Result<Mesh, Error> {
 
 #[cfg(test)]
 mod tests {
-    use super::{InMemory, balanced_bounds};
+    use super::balanced_bounds;
     use crate::Scalar;
+    use crate::extract::InMemory;
+    use crate::survey::Survey;
     use std::vec::Vec;
 
     /// All of the surface lies in ten slices in the middle of 101: the chunks cover every layer
@@ -224,7 +210,8 @@ mod tests {
             data: &data,
             nxy: 32 * 32,
         };
-        let bounds = balanced_bounds(&src, dims, u8::threshold(0.5), 4);
+        let survey = Survey::new(&src, dims, u8::threshold(0.5));
+        let bounds = balanced_bounds(&survey, dims, 4);
         assert_eq!(bounds.len(), 4);
         assert_eq!(bounds.first().map(|b| b.0), Some(0));
         assert_eq!(bounds.last().map(|b| b.1), Some(100));
