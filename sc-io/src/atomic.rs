@@ -122,7 +122,10 @@ impl AtomicFile {
     ) -> Result<Filled> {
         let fail =
             |e: io::Error| Error::file(&self.target, format!("cannot write: {}", io_reason(&e)));
-        let mut out = BufWriter::with_capacity(1 << 20, self.temp.as_file());
+        // 64 KiB: enough to batch the text formats' small writes. The binary writers hand over
+        // larger batches, which pass straight through; a 1 MiB buffer only added 256 pages to
+        // fault in (0.5 ms of a small scan's 15 ms run).
+        let mut out = BufWriter::with_capacity(1 << 16, self.temp.as_file());
         fill(&mut out).map_err(fail)?;
         out.flush().map_err(fail)?;
         drop(out);

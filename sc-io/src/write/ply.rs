@@ -63,7 +63,8 @@ fn in_chunks(
     out: &mut impl Write,
     encode: impl Fn(usize, &mut [u8]),
 ) -> io::Result<()> {
-    const BATCH: usize = 4096;
+    // At least 64 KiB per batch, so that batches bypass the output's `BufWriter`.
+    const BATCH: usize = 8192;
     let mut buf = vec![0u8; BATCH * record];
     for start in (0..count).step_by(BATCH) {
         let n = BATCH.min(count - start);
