@@ -75,7 +75,7 @@ pub fn extract_par<T: Scalar>(
     let threshold = T::threshold(params.iso);
     let survey = Survey::from_sampled(
         (0..dims[2])
-            .step_by(survey::STEP)
+            .step_by(survey::SLICE_STEP)
             .collect::<Vec<_>>()
             .par_iter()
             .map_init(Vec::new, |signs, &z| {
