@@ -11,7 +11,7 @@
 //! records where its x-edges change, and a cube row only visits the span where its four sample
 //! rows can disagree.
 
-use crate::scratch::{Scratch, WORD_PLANES};
+use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::{Entry, NO_EAR};
 use crate::vertex::{Field, sample_crossing};
 
@@ -48,9 +48,9 @@ struct Grid<'s> {
     entries: &'static [Entry; 2048],
     /// Per entry, bit `axis` set iff that grey edge may merge (embedded table).
     mergeable: &'static [u8; 2048],
-    /// Four slices of 0/1 bytes, slice `z` at `z % 4`.
+    /// Four slices of 0/1 bytes, slice `z` at `z % 4`, then [`PAD`] bytes.
     filled: &'s mut [u8],
-    /// Three layers of cube cases, layer `k` at `k % 3`, row stride `nx`.
+    /// Three layers of cube cases, layer `k` at `k % 3`, row stride `nx`, then [`PAD`] bytes.
     cases: &'s mut [u8],
     /// `(lo, hi)` pairs: per classified row, the x-edge changes lie in `lo..hi` (`lo = nx − 1`,
     /// `hi = 0` for a uniform row); per cube row, the non-trivial cubes lie in `lo..hi`.
@@ -95,8 +95,8 @@ pub(crate) struct Sweep<'s, T: Scalar> {
 impl<'s, T: Scalar> Sweep<'s, T> {
     pub fn new(dims: [usize; 3], params: &Params, scratch: Scratch<'s>) -> Self {
         let nxy = dims[0] * dims[1];
-        let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy);
-        let (cases, merged) = rest.split_at_mut(3 * nxy);
+        let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy + PAD);
+        let (cases, merged) = rest.split_at_mut(3 * nxy + PAD);
         let (ids, spans) = scratch.words.split_at_mut(WORD_PLANES * nxy);
         Sweep {
             grid: Grid {
@@ -247,7 +247,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let ybase = xbase + nx * ny;
         let [px, py, pz] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
-            let row = grid.row(n, y);
+            let row = grid.padded_row(n, y);
             let values = &samples[y * nx..][..nx];
             let (lo, hi) = grid.span(grid.slice_row(n, y));
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
@@ -260,7 +260,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 Ok(())
             })?;
             if y + 1 < ny {
-                let next = grid.row(n, y + 1);
+                let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
                 let (start, end) = grid.union_span([(y, n), (y + 1, n)]);
                 let ids = ybase + y * nx;
@@ -293,7 +293,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
-            let (below, above) = (grid.row(k, y), grid.row(k + 1, y));
+            let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
             let (start, end) = grid.union_span([(y, k), (y, k + 1)]);
             let ids = zbase + y * nx;
@@ -340,7 +340,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [(x_lo, x_hi), (y_lo, y_hi), _] = grid.own_cubes;
         for j in y_lo..y_hi {
             let (start, end) = grid.span(grid.case_row(k, j));
-            let cases = &grid.cases[(k % 3) * nxy + j * nx..][..nx];
+            let cases = &grid.cases[(k % 3) * nxy + j * nx..];
             let class_jk = ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
             let (start, end) = (start.max(x_lo), end.min(x_hi));
             if start >= end {
@@ -483,8 +483,15 @@ impl Out<'_> {
 impl Grid<'_> {
     #[inline(always)]
     fn row(&self, z: usize, y: usize) -> &[u8] {
+        &self.padded_row(z, y)[..self.dims[0]]
+    }
+
+    /// A classified row and whatever follows it, at least [`PAD`] bytes: what
+    /// [`for_each_differing`] reads.
+    #[inline(always)]
+    fn padded_row(&self, z: usize, y: usize) -> &[u8] {
         let [nx, ny, _] = self.dims;
-        &self.filled[(z % 4) * nx * ny + y * nx..][..nx]
+        &self.filled[(z % 4) * nx * ny + y * nx..]
     }
 
     /// Whether this sweep counts the edge with lower end `p` (see [`Sweep::restrict`]).
@@ -760,17 +767,18 @@ impl Grid<'_> {
 
 /// The `x` in `start..end`, in order, whose cube the surface crosses (its case is neither 0 nor
 /// 255), with the case. Tests eight cases at a time: most of a row's span lies wholly inside or
-/// outside the surface (seven in eight cubes of brainsmall's spans).
+/// outside the surface (seven in eight cubes of brainsmall's spans). `cases` runs at least seven
+/// bytes past `end` (see [`within`]).
 #[inline(always)]
 fn crossed(cases: &[u8], start: usize, end: usize) -> impl Iterator<Item = (usize, u8)> + '_ {
     const LOW_BITS: u64 = 0x0101_0101_0101_0101;
     let mut x = start;
     core::iter::from_fn(move || {
-        while x + 8 <= end {
+        while x < end {
             let word = u64::from_le_bytes(cases[x..x + 8].try_into().expect("eight bytes"));
             // A byte is 0 or 255 exactly when it equals its low bit times 255: the others are
             // the non-zero bytes of `crossed`.
-            let crossed = word ^ ((word & LOW_BITS) * 0xFF);
+            let crossed = (word ^ ((word & LOW_BITS) * 0xFF)) & within(end - x);
             if crossed != 0 {
                 let at = x + crossed.trailing_zeros() as usize / 8;
                 x = at + 1;
@@ -778,21 +786,24 @@ fn crossed(cases: &[u8], start: usize, end: usize) -> impl Iterator<Item = (usiz
             }
             x += 8;
         }
-        while x < end {
-            let (at, case) = (x, cases[x]);
-            x += 1;
-            if case != 0 && case != 255 {
-                return Some((at, case));
-            }
-        }
         None
     })
 }
 
+/// The mask of an eight-byte word's first `left` bytes (all eight when `left` is 8 or more).
+/// Rows are read a whole word at a time, past their end into padding or the next row, and the
+/// mask keeps what lies within: a byte-by-byte loop over the last few bytes of each row cost
+/// about 2 % of brainsmall's instructions.
+#[inline(always)]
+fn within(left: usize) -> u64 {
+    u64::MAX >> (8 * (8 - left.min(8)))
+}
+
 /// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing eight
-/// bytes at a time: most of a row's span is unchanged, and a vertex is the rare event. The short
-/// tail is folded into the same mask loop, so that `f` has one call site and is inlined: called
-/// out of line, once per vertex, it cost a fifth of the vertex passes.
+/// bytes at a time: most of a row's span is unchanged, and a vertex is the rare event. Both
+/// slices run at least seven bytes past `end`: the last word is read whole and masked, so that
+/// `f` has one call site and is inlined (called out of line, once per vertex, it cost a fifth of
+/// the vertex passes).
 #[inline]
 fn for_each_differing(
     a: &[u8],
@@ -803,19 +814,14 @@ fn for_each_differing(
 ) -> Result<(), Error> {
     let mut x = start;
     while x < end {
-        let n = (end - x).min(8);
-        let mut diff = if n == 8 {
-            let word = |r: &[u8]| u64::from_le_bytes(r[x..x + 8].try_into().expect("eight bytes"));
-            word(a) ^ word(b)
-        } else {
-            (0..n).fold(0, |m, i| m | u64::from(a[x + i] != b[x + i]) << (8 * i))
-        };
+        let word = |r: &[u8]| u64::from_le_bytes(r[x..x + 8].try_into().expect("eight bytes"));
+        let mut diff = (word(a) ^ word(b)) & within(end - x);
         while diff != 0 {
             let byte = diff.trailing_zeros() as usize / 8;
             f(x + byte)?;
             diff &= !(0xFF << (8 * byte));
         }
-        x += n;
+        x += 8;
     }
     Ok(())
 }
@@ -853,16 +859,15 @@ fn last_differing(row: &[u8], v: u8) -> Option<usize> {
 
 #[cfg(test)]
 mod tests {
-    use super::crossed;
+    use super::{crossed, for_each_differing};
     use alloc::vec::Vec;
 
-    /// `crossed` finds exactly the cases a byte-by-byte filter finds, for every sub-range of rows
-    /// mixing runs of 0 and 255 with crossed cases at every position of an eight-byte word.
-    #[test]
-    fn crossed_matches_a_plain_filter() {
+    /// Rows mixing runs of 0 and 255 with crossed cases at every position of an eight-byte word,
+    /// each followed by seven crossed bytes that the scans must not report.
+    fn rows() -> impl Iterator<Item = (Vec<u8>, usize)> {
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        for _ in 0..200 {
-            let row: Vec<u8> = (0..37)
+        (0..200).map(move |_| {
+            let mut row: Vec<u8> = (0..37)
                 .map(|_| {
                     state = state
                         .wrapping_mul(6364136223846793005)
@@ -875,13 +880,46 @@ mod tests {
                     }
                 })
                 .collect();
-            for start in 0..row.len() {
-                for end in start..=row.len() {
+            let len = row.len();
+            row.extend([7; 7]);
+            (row, len)
+        })
+    }
+
+    /// `crossed` finds exactly the cases a byte-by-byte filter finds, for every sub-range.
+    #[test]
+    fn crossed_matches_a_plain_filter() {
+        for (row, len) in rows() {
+            for start in 0..len {
+                for end in start..=len {
                     let plain: Vec<(usize, u8)> = (start..end)
                         .map(|x| (x, row[x]))
                         .filter(|&(_, c)| c != 0 && c != 255)
                         .collect();
                     assert_eq!(crossed(&row, start, end).collect::<Vec<_>>(), plain);
+                }
+            }
+        }
+    }
+
+    /// `for_each_differing` visits exactly the positions where two rows differ, in order, for
+    /// every sub-range; past `end` the rows differ everywhere, and must not be visited.
+    #[test]
+    fn for_each_differing_matches_a_plain_filter() {
+        let all: Vec<(Vec<u8>, usize)> = rows().collect();
+        for pair in all.windows(2) {
+            let ((a, len), (b, _)) = (&pair[0], &pair[1]);
+            let b: Vec<u8> = b[..*len].iter().chain(&[8; 7]).copied().collect();
+            for start in 0..*len {
+                for end in start..=*len {
+                    let plain: Vec<usize> = (start..end).filter(|&x| a[x] != b[x]).collect();
+                    let mut seen = Vec::new();
+                    for_each_differing(a, &b, start, end, |x| {
+                        seen.push(x);
+                        Ok(())
+                    })
+                    .unwrap();
+                    assert_eq!(seen, plain);
                 }
             }
         }
