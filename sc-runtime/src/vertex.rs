@@ -42,6 +42,16 @@ pub(crate) fn sample_crossing<T: Scalar>(a: T, b: T, iso: f64) -> f64 {
     }
 }
 
+/// The square root: `std`'s where it is linked, which compiles to one instruction the optimiser
+/// sees through; `libm`'s (the same correctly rounded result) otherwise.
+#[inline(always)]
+fn sqrt(x: f64) -> f64 {
+    #[cfg(feature = "std")]
+    return x.sqrt();
+    #[cfg(not(feature = "std"))]
+    return libm::sqrt(x);
+}
+
 /// Reads samples and gradients around grid points of the slices a sweep step can see.
 pub(crate) struct Field<'v, T> {
     pub dims: [usize; 3],
@@ -114,7 +124,7 @@ impl<T: Scalar> Field<'_, T> {
             return None;
         }
         let i = nx * y + x;
-        let d = |a: T, b: T, axis: usize| (b.to_f64() - a.to_f64()) * self.steps[axis][1];
+        let d = |a: T, b: T, axis: usize| T::diff(a, b) * self.steps[axis][1];
         let [below, here, above, top] = self.slices;
         Some(match AXIS {
             0 => {
@@ -170,7 +180,7 @@ impl<T: Scalar> Field<'_, T> {
         let squared = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
         // Positive and finite; NaN fails both tests.
         if squared > 0.0 && squared < f64::INFINITY {
-            let inv = 1.0 / libm::sqrt(squared);
+            let inv = 1.0 / sqrt(squared);
             g.map(|c| (c * inv) as f32)
         } else {
             let mut n = [0.0; 3];
