@@ -30,6 +30,9 @@ impl Mesh {
         }
         // A closed surface has about two triangles per vertex before merging.
         self.triangles.reserve_exact(2 * v);
+        huge_pages(&mut self.positions);
+        huge_pages(&mut self.normals);
+        huge_pages(&mut self.triangles);
     }
 }
 
@@ -111,3 +114,30 @@ pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mes
     mesh.stats = extract_into(volume, params, scratch.lend(), &mut mesh)?;
     Ok(mesh)
 }
+
+/// Asks the kernel to back a large buffer with 2 MiB pages, before it is first touched.
+#[cfg(all(feature = "std", target_os = "linux"))]
+pub(crate) fn huge_pages<T>(v: &mut Vec<T>) {
+    const HUGE: usize = 2 << 20;
+    let bytes = v.capacity() * core::mem::size_of::<T>();
+    if bytes < 2 * HUGE {
+        return;
+    }
+    let start = v.as_mut_ptr() as usize;
+    let aligned = start.next_multiple_of(HUGE);
+    let end = (start + bytes) / HUGE * HUGE;
+    if end > aligned {
+        // SAFETY: advice only: the range lies within the vector's own allocation, and
+        // MADV_HUGEPAGE changes how its pages are backed, never their contents.
+        unsafe {
+            libc::madvise(
+                aligned as *mut libc::c_void,
+                end - aligned,
+                libc::MADV_HUGEPAGE,
+            );
+        }
+    }
+}
+
+#[cfg(not(all(feature = "std", target_os = "linux")))]
+pub(crate) fn huge_pages<T>(_: &mut Vec<T>) {}
