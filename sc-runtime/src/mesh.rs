@@ -21,9 +21,10 @@ pub struct Mesh {
 impl Mesh {
     /// Reserves room for a surface of about `vertices` Steps 1–3 vertices (a [`Survey`]
     /// estimate), with a margin, so that the buffers are allocated once: untouched reserved pages
-    /// cost address space, not memory.
+    /// cost address space, not memory. The margin, half as much again, covers estimates down to
+    /// two thirds of the count, and the survey's are within 0.90–1.01 on the benchmark volumes.
     pub(crate) fn reserve_for(&mut self, vertices: usize, normals: bool) {
-        let v = vertices + vertices / 4;
+        let v = vertices + vertices / 2;
         self.positions.reserve_exact(v);
         if normals {
             self.normals.reserve_exact(v);
