@@ -788,7 +788,10 @@ fn crossed(cases: &[u8], start: usize, end: usize) -> impl Iterator<Item = (usiz
             let word = u64::from_le_bytes(cases[x..x + 8].try_into().expect("eight bytes"));
             // A byte is 0 or 255 exactly when it equals its low bit times 255: the others are
             // the non-zero bytes of `crossed`.
-            let crossed = (word ^ ((word & LOW_BITS) * 0xFF)) & within(end - x);
+            let mut crossed = word ^ ((word & LOW_BITS) * 0xFF);
+            if end - x < 8 {
+                crossed &= within(end - x);
+            }
             if crossed != 0 {
                 let at = x + crossed.trailing_zeros() as usize / 8;
                 x = at + 1;
@@ -800,13 +803,13 @@ fn crossed(cases: &[u8], start: usize, end: usize) -> impl Iterator<Item = (usiz
     })
 }
 
-/// The mask of an eight-byte word's first `left` bytes (all eight when `left` is 8 or more).
+/// The mask of an eight-byte word's first `left` bytes, `left` below 8.
 /// Rows are read a whole word at a time, past their end into padding or the next row, and the
 /// mask keeps what lies within: a byte-by-byte loop over the last few bytes of each row cost
 /// about 2 % of brainsmall's instructions.
 #[inline(always)]
 fn within(left: usize) -> u64 {
-    u64::MAX >> (8 * (8 - left.min(8)))
+    u64::MAX >> (8 * (8 - left))
 }
 
 /// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing eight
@@ -825,7 +828,10 @@ fn for_each_differing(
     let mut x = start;
     while x < end {
         let word = |r: &[u8]| u64::from_le_bytes(r[x..x + 8].try_into().expect("eight bytes"));
-        let mut diff = (word(a) ^ word(b)) & within(end - x);
+        let mut diff = word(a) ^ word(b);
+        if end - x < 8 {
+            diff &= within(end - x);
+        }
         while diff != 0 {
             let byte = diff.trailing_zeros() as usize / 8;
             f(x + byte)?;
