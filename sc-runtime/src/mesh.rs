@@ -31,6 +31,11 @@ impl Mesh {
         }
         // A closed surface has about two triangles per vertex before merging.
         self.triangles.reserve_exact(2 * v);
+        self.advise_huge_pages();
+    }
+
+    /// [`huge_pages`] for each buffer, before any is first touched.
+    pub(crate) fn advise_huge_pages(&mut self) {
         huge_pages(&mut self.positions);
         huge_pages(&mut self.normals);
         huge_pages(&mut self.triangles);
@@ -118,7 +123,7 @@ pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mes
 
 /// Asks the kernel to back a large buffer with 2 MiB pages, before it is first touched.
 #[cfg(all(feature = "std", target_os = "linux"))]
-pub(crate) fn huge_pages<T>(v: &mut Vec<T>) {
+fn huge_pages<T>(v: &mut Vec<T>) {
     const HUGE: usize = 2 << 20;
     let bytes = v.capacity() * core::mem::size_of::<T>();
     if bytes < 2 * HUGE {
@@ -141,4 +146,4 @@ pub(crate) fn huge_pages<T>(v: &mut Vec<T>) {
 }
 
 #[cfg(not(all(feature = "std", target_os = "linux")))]
-pub(crate) fn huge_pages<T>(_: &mut Vec<T>) {}
+fn huge_pages<T>(_: &mut Vec<T>) {}

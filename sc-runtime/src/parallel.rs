@@ -157,9 +157,7 @@ fn stitch(parts: Vec<Part>) -> Result<Mesh, Error> {
         triangles: vec![[0; 3]; total_t],
         stats: Stats::default(),
     };
-    crate::mesh::huge_pages(&mut out.positions);
-    crate::mesh::huge_pages(&mut out.normals);
-    crate::mesh::huge_pages(&mut out.triangles);
+    out.advise_huge_pages();
     // Each chunk's destination slices, and the shift that makes its ids global: its id
     // `first_plane` is the first vertex it emitted.
     let mut jobs = Vec::with_capacity(parts.len());
