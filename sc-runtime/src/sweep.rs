@@ -481,9 +481,13 @@ impl Out<'_> {
                 let c = global[d] as i64 as f64 + if d == AXIS { t } else { 0.0 };
                 (params.origin[d] + c * params.spacing[d]) as f32
             });
-            let normal = params
-                .normals
-                .then(|| field.normal::<AXIS>(p, t, grid.is_filled(p)));
+            // An `if`, not `bool::then` with a closure: in the Python extension's build the
+            // closure was left out of line, three calls per vertex and 40 % more normals time.
+            let normal = if params.normals {
+                Some(field.normal::<AXIS>(p, t, grid.is_filled(p)))
+            } else {
+                None
+            };
             sink.edge_vertex(global, AXIS, pos, normal);
         }
         Ok(id)
