@@ -78,6 +78,9 @@ pub fn skimage_mesh<'py>(
 /// lies on a grid edge at least 1/1024 of it from either end, so one coordinate (in grid steps)
 /// is clearly fractional and the other two are whole up to rounding: the edge's lower end is
 /// that coordinate's floor and the others' nearest integers.
+///
+/// This pass was a sixth of `marching_cubes`' time on the stent CT: it now converts through
+/// `i64` (one instruction; `usize` takes several) and picks the axis without a loop.
 fn edge_values<T: Scalar + Element>(
     data: &[T],
     dims: [usize; 3],
@@ -85,30 +88,34 @@ fn edge_values<T: Scalar + Element>(
     positions: &[[f32; 3]],
 ) -> Vec<f32> {
     let [nx, ny, _] = dims;
-    let at = |p: [usize; 3]| data[p[0] + nx * (p[1] + ny * p[2])].to_f64();
+    let strides = [1, nx as i64, (nx * ny) as i64];
     let inverse = spacing.map(|s| 1.0 / s);
-    // Coordinates are at least 0 (the origin is 0), so truncation is floor and `+ 0.5` then
-    // truncation rounds: one instruction each, where `floor` and `round` are library calls.
-    let last = dims.map(|n| n - 1);
+    let sample = |i: i64| {
+        usize::try_from(i)
+            .ok()
+            .and_then(|i| data.get(i))
+            .map_or(f64::NAN, |v| v.to_f64())
+    };
     positions
         .iter()
         .map(|pos| {
-            let c: [f64; 3] = core::array::from_fn(|d| (f64::from(pos[d]) * inverse[d]).max(0.0));
-            let near = c.map(|v| (v + 0.5) as usize);
-            let off = core::array::from_fn::<f64, 3, _>(|d| (c[d] - near[d] as f64).abs());
-            let axis = (0..3).fold(0, |a, d| if off[d] > off[a] { d } else { a });
-            let mut lower = near;
-            lower[axis] = c[axis] as usize;
-            let lower = core::array::from_fn(|d| lower[d].min(last[d]));
-            let mut upper = lower;
-            upper[axis] = (upper[axis] + 1).min(last[axis]);
-            let (a, b) = (at(lower), at(upper));
-            // As NumPy's maximum: a NaN end gives NaN.
-            if a.is_nan() || b.is_nan() {
-                f32::NAN
+            // Coordinates are at least 0 (the origin is 0), so truncation is floor and
+            // `+ 0.5` then truncation rounds.
+            let c: [f64; 3] = core::array::from_fn(|d| f64::from(pos[d]) * inverse[d]);
+            let near = c.map(|v| (v + 0.5) as i64);
+            let off: [f64; 3] = core::array::from_fn(|d| (c[d] - near[d] as f64).abs());
+            let axis = if off[0] >= off[1] && off[0] >= off[2] {
+                0
+            } else if off[1] >= off[2] {
+                1
             } else {
-                a.max(b) as f32
-            }
+                2
+            };
+            let at = near[0] + near[1] * strides[1] + near[2] * strides[2];
+            let lower = at - (near[axis] - c[axis] as i64) * strides[axis];
+            let (a, b) = (sample(lower), sample(lower + strides[axis]));
+            // As NumPy's maximum: a NaN end gives NaN.
+            (if a > b || a.is_nan() { a } else { b }) as f32
         })
         .collect()
 }
