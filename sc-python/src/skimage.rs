@@ -79,8 +79,9 @@ pub fn skimage_mesh<'py>(
 /// is clearly fractional and the other two are whole up to rounding: the edge's lower end is
 /// that coordinate's floor and the others' nearest integers.
 ///
-/// This pass was a sixth of `marching_cubes`' time on the stent CT: it now converts through
-/// `i64` (one instruction; `usize` takes several) and picks the axis without a loop.
+/// This pass was a sixth of `marching_cubes`' time on the stent CT, mostly waiting for the
+/// volume to come back into cache: it converts through `i64` (one instruction; `usize` takes
+/// several) and picks the axis without a loop. Now 8 % of the MNI white matter's time.
 fn edge_values<T: Scalar + Element>(
     data: &[T],
     dims: [usize; 3],
@@ -96,9 +97,13 @@ fn edge_values<T: Scalar + Element>(
             .and_then(|i| data.get(i))
             .map_or(f64::NAN, |v| v.to_f64())
     };
-    positions
-        .iter()
-        .map(|pos| {
+    // Indices first, loads after, a batch at a time: the volume is no longer in cache, and
+    // a loop of loads only keeps many misses in flight at once.
+    const BATCH: usize = 256;
+    let mut values = Vec::with_capacity(positions.len());
+    let mut ends = [(0i64, 0i64); BATCH];
+    for batch in positions.chunks(BATCH) {
+        for (pos, end) in batch.iter().zip(&mut ends) {
             // Coordinates are at least 0 (the origin is 0), so truncation is floor and
             // `+ 0.5` then truncation rounds.
             let c: [f64; 3] = core::array::from_fn(|d| f64::from(pos[d]) * inverse[d]);
@@ -112,10 +117,16 @@ fn edge_values<T: Scalar + Element>(
                 2
             };
             let at = near[0] + near[1] * strides[1] + near[2] * strides[2];
-            let lower = at - (near[axis] - c[axis] as i64) * strides[axis];
-            let (a, b) = (sample(lower), sample(lower + strides[axis]));
+            *end = (
+                at - (near[axis] - c[axis] as i64) * strides[axis],
+                strides[axis],
+            );
+        }
+        values.extend(ends[..batch.len()].iter().map(|&(lower, step)| {
+            let (a, b) = (sample(lower), sample(lower + step));
             // As NumPy's maximum: a NaN end gives NaN.
             (if a > b || a.is_nan() { a } else { b }) as f32
-        })
-        .collect()
+        }));
+    }
+    values
 }
