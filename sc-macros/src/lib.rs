@@ -170,9 +170,23 @@ fn packed(triangles: &[[u8; 3]], grey: &[Grey]) -> Tokens {
         mergeable |= u8::from(g.mergeable) << axis;
     }
     let count = triangles.len() as u8;
+    let ear_axes = (0..3).fold(0u8, |m, axis| m | u8::from(ears[axis] != NO_EAR) << axis);
+    let all = ((1u16 << count) - 1) as u8;
+    let kept = (0..8u8).map(|merged| {
+        (0..3)
+            .filter(|&axis| merged >> axis & 1 == 1 && ears[axis] != NO_EAR)
+            .fold(all, |k, axis| k & !(1 << ears[axis]))
+    });
     let tris = tris.iter().map(|[a, b, c]| quote!([#a, #b, #c]));
     quote! {
-        ::sc_runtime::tables::Entry { tris: [#(#tris),*], count: #count, ears: [#(#ears),*], mergeable: #mergeable }
+        ::sc_runtime::tables::Entry {
+            tris: [#(#tris),*],
+            count: #count,
+            ears: [#(#ears),*],
+            mergeable: #mergeable,
+            ear_axes: #ear_axes,
+            kept: [#(#kept),*],
+        }
     }
 }
 

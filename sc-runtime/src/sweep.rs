@@ -12,7 +12,7 @@
 //! rows can disagree.
 
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
-use crate::tables::{Entry, NO_EAR};
+use crate::tables::Entry;
 use crate::vertex::{Field, sample_crossing};
 
 mod bound;
@@ -363,17 +363,13 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let at = i + nx * j;
                 let id = |e: u8| ids[edge_at[usize::from(e & 15)] + at];
                 // A merged grey edge's ear is dropped; the pair's owner emits the merged
-                // triangle in its place (its partner emits nothing). Masks rather than branches:
-                // which greys merged is data, and data-dependent branches mispredict.
-                let (mut merged, mut dropped) = (0u8, 0u8);
+                // triangle in its place (its partner emits nothing). Table lookups rather than
+                // branches: which greys merged is data, and data-dependent branches mispredict.
+                let mut kept = entry.kept[0];
                 if merging {
-                    let marks = marks[at] >> shift;
-                    for (axis, &ear) in entry.ears.iter().enumerate() {
-                        let m = (marks >> axis) & u8::from(ear != NO_EAR);
-                        merged |= m << axis;
-                        dropped |= m << (ear & 7);
-                    }
-                    let mut owned = merged & OWNS[class];
+                    let marks = usize::from(marks[at] >> shift & 7);
+                    kept = entry.kept[marks];
+                    let mut owned = marks as u8 & entry.ear_axes & OWNS[class];
                     while owned != 0 {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
@@ -382,7 +378,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                         sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
                 }
-                let mut kept = ((1u16 << entry.count) - 1) as u8 & !dropped;
                 while kept != 0 {
                     let n = kept.trailing_zeros() as usize;
                     kept &= kept - 1;
