@@ -7,8 +7,10 @@
 /// Marks a grey axis without an ear in [`Entry::ears`].
 pub const NO_EAR: u8 = 0xFF;
 
-/// One class-and-case entry, packed for the extraction loop.
+/// One class-and-case entry, packed for the extraction loop. Aligned to 32 bytes, so that an
+/// entry never straddles two cache lines and its address is a shift.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(align(32))]
 pub struct Entry {
     /// Triangles as edge-id triples; only the first `count` are used. Ear triangles are stored
     /// with their grey edge in the middle, `[back, grey, forward]`.
