@@ -1,3 +1,4 @@
+use std::sync::Mutex;
 use std::vec;
 use std::vec::Vec;
 
@@ -84,28 +85,41 @@ pub fn extract_par<T: Scalar>(
             .collect(),
     );
     let bounds = balanced_bounds(&survey, dims, chunks);
+    // The chunks' meshes and the workers' scratch are allocated here, not on the workers: glibc
+    // gives each worker thread an arena of its own and returns what is freed there to the
+    // kernel, so every extraction faulted those pages in again (on the MNI brain's white matter,
+    // 3,100 page faults per extraction instead of 70).
+    let meshes: Vec<Mesh> = bounds
+        .iter()
+        .map(|&(z0, z1)| {
+            let mut mesh = Mesh::default();
+            mesh.reserve_for(survey.between(z0, z1 + 1), params.normals);
+            mesh
+        })
+        .collect();
+    let scratches = (0..workers)
+        .map(|_| OwnedScratch::new(dims).map(Mutex::new))
+        .collect::<Result<Vec<_>, _>>()?;
     let run = || {
         let parts: Vec<Result<Part, Error>> = bounds
             .par_iter()
-            // Scratch is reused by the chunks one worker runs, rather than faulted in per chunk.
-            .map_init(
-                || OwnedScratch::new(dims),
-                |scratch, &(z0, z1)| {
-                    let scratch = scratch.as_mut().map_err(|e| e.clone())?;
-                    let mut mesh = Mesh::default();
-                    mesh.reserve_for(survey.between(z0, z1 + 1), params.normals);
-                    let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
-                    sweep.until(z1);
-                    sweep.start(z0, &src, &mut mesh, z0 == 0)?;
-                    let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
-                    for k in z0..z1 {
-                        sweep.layer(k, &src, &mut mesh)?;
-                        progress(1);
-                    }
-                    mesh.stats = sweep.stats();
-                    Ok(Part { mesh, first_plane })
-                },
-            )
+            .zip(meshes)
+            .map(|(&(z0, z1), mut mesh)| {
+                // Each worker takes the scratch of its own index: the lock is never contended.
+                // A poisoned lock means a worker panicked, and that panic is on its way.
+                let slot = rayon::current_thread_index().unwrap_or(0) % scratches.len();
+                let mut scratch = scratches[slot].lock().unwrap_or_else(|p| p.into_inner());
+                let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
+                sweep.until(z1);
+                sweep.start(z0, &src, &mut mesh, z0 == 0)?;
+                let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
+                for k in z0..z1 {
+                    sweep.layer(k, &src, &mut mesh)?;
+                    progress(1);
+                }
+                mesh.stats = sweep.stats();
+                Ok(Part { mesh, first_plane })
+            })
             .collect();
         stitch(parts.into_iter().collect::<Result<Vec<_>, _>>()?)
     };
@@ -195,6 +209,7 @@ mod tests {
     use crate::survey::Survey;
     use crate::sweep::Sweep;
     use crate::{Params, Scalar, Sink};
+    use std::sync::Mutex;
     use std::vec::Vec;
 
     /// A chunk's sweep extrapolates its output over its own layers. On a cylinder along z every
