@@ -209,7 +209,6 @@ mod tests {
     use crate::survey::Survey;
     use crate::sweep::Sweep;
     use crate::{Params, Scalar, Sink};
-    use std::sync::Mutex;
     use std::vec::Vec;
 
     /// A chunk's sweep extrapolates its output over its own layers. On a cylinder along z every
