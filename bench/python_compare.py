@@ -121,6 +121,8 @@ def timed(fn, vol, iso, repeat):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--only", nargs="*", default=[],
+                    help="volume labels to run (prefixes, e.g. mni152-f32@190), to rerun rows")
     a = ap.parse_args()
     vtk.vtkSMPTools().Initialize(1)
     cpu = next(
@@ -135,6 +137,8 @@ def main():
           + " | scikit-image / ours | ours / FE |")
     print("|---" * (len(names) + 3) + "|")
     for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR")):
+        if a.only and not any(label.startswith(o) for o in a.only):
+            continue
         row = {n: timed(PEERS[n], vol, iso, a.repeat) for n in names}
         ours = row["skelclimb"][0]
         cells = " | ".join(f"{t:.1f} ({f:,})" for t, f in row.values())
