@@ -72,6 +72,25 @@ impl Sink for Mesh {
     }
 }
 
+/// A mesh the survey has sized ([`Mesh::reserve_for`]): it takes the sweep's output but not its
+/// growth hints. The hints extrapolate the layers done over the layers left; on a surface dense
+/// in its first layers (the ITK MRI) they asked for up to 1.6 times the survey's reservation,
+/// though the whole surface fitted in it, and each extraction copied its vectors into fresh
+/// pages. Should the survey fall short, the vectors still grow as vectors do.
+pub(crate) struct Presized<'m>(pub &'m mut Mesh);
+
+impl Sink for Presized<'_> {
+    #[inline]
+    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
+        self.0.vertex(position, normal);
+    }
+
+    #[inline]
+    fn triangle(&mut self, triangle: [u32; 3]) {
+        self.0.triangle(triangle);
+    }
+}
+
 /// Scratch buffers owned on the heap.
 pub(crate) struct OwnedScratch {
     bytes: Vec<u8>,
@@ -117,7 +136,7 @@ pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mes
         let survey = Survey::new(&src, dims, T::threshold(params.iso));
         mesh.reserve_for(survey.between(0, dims[2]), params.normals);
     }
-    mesh.stats = extract_into(volume, params, scratch.lend(), &mut mesh)?;
+    mesh.stats = extract_into(volume, params, scratch.lend(), &mut Presized(&mut mesh))?;
     Ok(mesh)
 }
 
@@ -147,3 +166,41 @@ fn huge_pages<T>(v: &mut Vec<T>) {
 
 #[cfg(not(all(feature = "std", target_os = "linux")))]
 fn huge_pages<T>(_: &mut Vec<T>) {}
+
+#[cfg(test)]
+mod tests {
+    use crate::extract::InMemory;
+    use crate::survey::Survey;
+    use crate::{Params, Scalar, Volume, extract};
+    use alloc::vec::Vec;
+
+    /// A ball in the first quarter of the layers: after its first layers the sweep's hints
+    /// extrapolate its surface over all 95 layers, many times what there is. The survey's
+    /// reservation holds the whole surface, and no hint reallocates it.
+    #[test]
+    fn a_surveyed_mesh_keeps_its_reservation() {
+        let dims = [32, 32, 96];
+        let data: Vec<f32> = (0..dims.iter().product::<usize>())
+            .map(|i| {
+                let d = |c: usize, at: f32| c as f32 - at;
+                let (x, y, z) = (d(i % 32, 15.5), d((i / 32) % 32, 15.5), d(i / 1024, 14.0));
+                12.0 - (x * x + y * y + z * z).sqrt()
+            })
+            .collect();
+        let src = InMemory {
+            data: &data,
+            nxy: 32 * 32,
+        };
+        let estimate = Survey::new(&src, dims, f32::threshold(0.0)).between(0, dims[2]);
+        let reserved = estimate + estimate / 2;
+        let mesh = extract(&Volume::new(&data, dims).unwrap(), &Params::new(0.0)).unwrap();
+        assert!(
+            mesh.positions.len() <= reserved && mesh.triangles.len() <= 2 * reserved,
+            "{estimate} {} {}",
+            mesh.positions.len(),
+            mesh.triangles.len()
+        );
+        assert_eq!(mesh.positions.capacity(), reserved);
+        assert_eq!(mesh.triangles.capacity(), 2 * reserved);
+    }
+}

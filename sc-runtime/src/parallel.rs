@@ -5,7 +5,7 @@ use std::vec::Vec;
 use rayon::prelude::*;
 
 use crate::extract::{InMemory, has_cubes};
-use crate::mesh::OwnedScratch;
+use crate::mesh::{OwnedScratch, Presized};
 use crate::survey::{self, Survey};
 use crate::sweep::Sweep;
 use crate::{Error, Mesh, Params, Scalar, Stats, Volume};
@@ -111,11 +111,11 @@ pub fn extract_par<T: Scalar>(
                 let slot = rayon::current_thread_index().unwrap_or(0) % scratches.len();
                 let mut scratch = scratches[slot].lock().unwrap_or_else(|p| p.into_inner());
                 let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
-                sweep.until(z1);
-                sweep.start(z0, &src, &mut mesh, z0 == 0)?;
+                let sink = &mut Presized(&mut mesh);
+                sweep.start(z0, &src, sink, z0 == 0)?;
                 let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
                 for k in z0..z1 {
-                    sweep.layer(k, &src, &mut mesh)?;
+                    sweep.layer(k, &src, sink)?;
                     progress(1);
                 }
                 mesh.stats = sweep.stats();
@@ -205,58 +205,10 @@ fn stitch(parts: Vec<Part>) -> Result<Mesh, Error> {
 #[cfg(test)]
 mod tests {
     use super::balanced_bounds;
+    use crate::Scalar;
     use crate::extract::InMemory;
-    use crate::mesh::OwnedScratch;
     use crate::survey::Survey;
-    use crate::sweep::Sweep;
-    use crate::{Params, Scalar, Sink};
     use std::vec::Vec;
-
-    /// A chunk's sweep extrapolates its output over its own layers. On a cylinder along z every
-    /// layer adds the same vertices, so after each layer the hint is exactly what the chunk has
-    /// left. Extrapolated over the rest of the grid instead, the hints once reserved many times
-    /// a chunk's mesh, and two threads took longer than one.
-    #[test]
-    fn a_chunk_expects_only_its_own_layers() {
-        #[derive(Default)]
-        struct Hints {
-            vertices: usize,
-            hints: Vec<usize>,
-        }
-        impl Sink for Hints {
-            fn vertex(&mut self, _: [f32; 3], _: Option<[f32; 3]>) {
-                self.vertices += 1;
-            }
-            fn triangle(&mut self, _: [u32; 3]) {}
-            fn expect(&mut self, vertices: usize, _: usize) {
-                self.hints.push(vertices);
-            }
-        }
-        let dims = [16, 16, 64];
-        let data: Vec<u8> = (0..dims.iter().product::<usize>())
-            .map(|i| {
-                let (x, y) = ((i % 16) as f64 - 7.5, ((i / 16) % 16) as f64 - 7.5);
-                u8::from(x * x + y * y < 25.0)
-            })
-            .collect();
-        let src = InMemory {
-            data: &data,
-            nxy: 16 * 16,
-        };
-        let (z0, z1) = (20, 30);
-        let mut scratch = OwnedScratch::new(dims).unwrap();
-        let mut sweep = Sweep::<u8>::new(dims, &Params::new(0.5), scratch.lend());
-        sweep.until(z1);
-        let mut sink = Hints::default();
-        sweep.start(z0, &src, &mut sink, false).unwrap();
-        for k in z0..z1 {
-            sweep.layer(k, &src, &mut sink).unwrap();
-        }
-        let per_layer = sink.vertices / (z1 - z0);
-        assert!(per_layer > 0);
-        let want: Vec<usize> = (z0..z1).map(|k| per_layer * (z1 - k - 1)).collect();
-        assert_eq!(sink.hints, want);
-    }
 
     /// All of the surface lies in ten slices in the middle of 101: the chunks cover every layer
     /// once, in order, and most of them go to the band, where equal ranges of layers would give

@@ -88,8 +88,6 @@ pub(crate) struct Sweep<'s, T: Scalar> {
     threshold: T::Threshold,
     /// The layer `start` prepared: where this sweep's output began.
     first_layer: usize,
-    /// The layer after this sweep's last: the whole grid's unless [`Sweep::until`] says less.
-    end_layer: usize,
     /// The gradient's reciprocal steps, computed once.
     steps: [[f64; 2]; 3],
 }
@@ -124,7 +122,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             params: *params,
             threshold: T::threshold(params.iso),
             first_layer: 0,
-            end_layer: dims[2].saturating_sub(1),
             steps: Field::<T>::steps(params.spacing),
         }
     }
@@ -148,13 +145,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 },
             )
         });
-    }
-
-    /// Ends this sweep before layer `end` (a parallel chunk's), so that its output is
-    /// extrapolated over its own layers, not over the rest of the grid.
-    #[cfg(feature = "std")]
-    pub fn until(&mut self, end: usize) {
-        self.end_layer = end;
     }
 
     pub fn stats(&self) -> Stats {
@@ -217,7 +207,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         if self.out.emit {
             // Layers done since this sweep started, and the ones left, extrapolate the output.
             let done = (k + 1 - self.first_layer) as u64;
-            let left = self.end_layer.saturating_sub(k + 1) as u64;
+            let left = (self.grid.dims[2] - 1).saturating_sub(k + 1) as u64;
             let per = |n: u64| usize::try_from(n * left / done).unwrap_or(usize::MAX);
             sink.expect(per(self.out.stats.vertices), per(self.out.stats.triangles));
         }
