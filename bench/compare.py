@@ -1,22 +1,26 @@
 #!/usr/bin/env python3
 """Skeleton Climbing against VTK's vtkFlyingEdges3D, measured in one run on the same volumes.
 
-Runs `cargo bench -p sc-runtime --bench extract` (criterion), then times FlyingEdges on each
-volume the benchmarks used (the built-in 256³ volumes, rebuilt here sample for sample, and the
-SC_DATA_DIR volumes at each suggested iso value), and prints the README's speed tables: times,
-ratios, Step 4's and normals' costs, two-thread speed-ups, and the whole `skelclimb extract`
-process against its extraction.
+For each volume (the built-in 256³ volumes, rebuilt here sample for sample, and the SC_DATA_DIR
+volumes at each suggested iso value), in turn: our criterion benchmarks of that volume alone
+(`SC_BENCH_ONLY=<volume> cargo bench -p sc-runtime --bench extract`), then FlyingEdges on the
+same array. That is one round; `--rounds` of them are run, so that both sides of every ratio are
+measured within seconds of each other, several times over: this machine's speed drifts by tens
+of per cent from minute to minute. Then it prints the README's speed tables: times and ratios
+(medians over the rounds, and the headline ratios' range), Step 4's and normals' costs,
+two-thread speed-ups, and the whole `skelclimb extract` process against its extraction.
 
     pip install vtk numpy
-    SC_DATA_DIR=../shared/data python3 bench/compare.py [--skip-cargo] [--repeat 9]
+    SC_DATA_DIR=/abs/path/to/data python3 bench/compare.py [--rounds 3] [--repeat 9] [--only GROUP ...]
 
 With SC_DATA_DIR set, bench/derive_volumes.py first derives larger u8, i16 and f32 volumes from
 it into target/bench-data, and both folders are benchmarked.
 
 Times are milliseconds, medians. FlyingEdges runs with gradients and scalars off, normals off
-unless the column says otherwise, on one thread unless the column says otherwise.
+unless the column says otherwise, on one thread unless the column says otherwise; it is run once
+untimed before each timed series, as criterion warms ours up.
 """
-import argparse, glob, json, os, platform, subprocess, sys, tempfile, time
+import argparse, glob, json, os, platform, shutil, statistics, subprocess, sys, tempfile, time
 import numpy as np
 import vtk
 from vtk.util import numpy_support
@@ -109,6 +113,7 @@ def flying_edges(arr, iso, threads, repeat, normals=False):
     fe.SetComputeNormals(normals)
     fe.SetComputeGradients(False)
     fe.SetComputeScalars(False)
+    fe.Update()
     times = []
     for _ in range(repeat):
         fe.Modified()
@@ -148,44 +153,91 @@ def process_times(group, repeat):
     return 1000 * sorted(whole)[repeat // 2], 1000 * sorted(extract)[repeat // 2], tris
 
 
+def groups_of():
+    """The benchmark groups: the built-in volumes, and each data volume at each suggested iso
+    value, named as the benchmark harness names them (`name@iso`, iso as Rust prints it)."""
+    groups = list(BUILTIN)
+    for d in data_dirs():
+        for name in sorted(os.listdir(d)):
+            meta_path = os.path.join(d, name, name + ".json")
+            if os.path.exists(meta_path):
+                isos = json.load(open(meta_path)).get("iso_suggestions", {}).values()
+                groups += [f"{name}@{iso:g}" for iso in isos if isinstance(iso, (int, float))]
+    return sorted(groups)
+
+
+def ours(group):
+    """Our criterion medians for one group, measured now: one thread in each mode, all
+    threads embedded, one thread embedded with normals."""
+    env = dict(os.environ, SC_BENCH_ONLY=group)
+    # Earlier results must not stand in for a run that measured nothing.
+    shutil.rmtree(os.path.join(ROOT, "target", "criterion", group), ignore_errors=True)
+    subprocess.run(["cargo", "bench", "--quiet", "-p", "sc-runtime", "--bench", "extract"], cwd=ROOT,
+                   env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    all_t = os.cpu_count() or 1
+    t = {f: criterion_ms(group, f, 1) for f in ("steps123", "embedded", "paper", "embedded-normals")}
+    t["embedded-all"] = criterion_ms(group, "embedded", all_t)
+    return None if None in t.values() else t
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--skip-cargo", action="store_true", help="reuse target/criterion results")
-    ap.add_argument("--repeat", type=int, default=9)
+    ap.add_argument("--rounds", type=int, default=3, help="rounds of every volume, ours then FE")
+    ap.add_argument("--repeat", type=int, default=9, help="timed Flying Edges runs per series")
+    ap.add_argument("--only", nargs="*", help="these groups only (say stent-ct@281)")
     a = ap.parse_args()
     if data_dirs():
         if not os.path.isdir(DERIVED):
             subprocess.run([sys.executable, os.path.join(ROOT, "bench", "derive_volumes.py"), DERIVED], check=True)
         os.environ["SC_DATA_DIR"] = os.pathsep.join(data_dirs() + [DERIVED])
-    if not a.skip_cargo:
-        subprocess.run(["cargo", "bench", "-p", "sc-runtime", "--bench", "extract"], cwd=ROOT, check=True)
+    subprocess.run(["cargo", "bench", "--no-run", "-p", "sc-runtime", "--bench", "extract"], cwd=ROOT, check=True)
     subprocess.run(["cargo", "build", "--quiet", "--release", "-p", "sc-cli"], cwd=ROOT, check=True)
     all_t = os.cpu_count() or 1
-    groups = sorted(os.listdir(os.path.join(ROOT, "target", "criterion")))
-    groups = [g for g in groups if g in BUILTIN or "@" in g]
+    groups = [g for g in groups_of() if not a.only or g in a.only]
+    arrays = {}
     backend = smp_backend()
+    runs = {g: [] for g in groups}
+    for r in range(a.rounds):
+        for n, g in enumerate(groups):
+            print(f"round {r + 1}/{a.rounds}, {n + 1}/{len(groups)}: {g}", file=sys.stderr, flush=True)
+            if g not in arrays:
+                arrays[g] = volume(g)
+            arr, iso = arrays[g]
+            t = ours(g)
+            if t is None:
+                continue
+            t["fe"], t["tris"] = flying_edges(arr, iso, 1, a.repeat)
+            t["fe-all"], _ = flying_edges(arr, iso, all_t, a.repeat)
+            t["fe-normals"], _ = flying_edges(arr, iso, 1, a.repeat, normals=True)
+            runs[g].append(t)
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), platform.processor())
-    print(f"\nMachine: {cpu}, {all_t} threads; VTK {vtk.vtkVersion.GetVTKVersion()} (SMP backend {backend})\n")
-    print(f"| volume (FE triangles) | FE | Steps 1–3 | embedded | paper | **embedded / FE** | Step 4 cost | normals: ours / FE's | FE, {all_t} threads | embedded, {all_t} threads | speed-up: ours / FE's | **embedded / FE, {all_t} threads** |")
+    print(f"\nMachine: {cpu}, {all_t} threads; VTK {vtk.vtkVersion.GetVTKVersion()} (SMP backend {backend}); "
+          f"medians of {a.rounds} rounds, the headline ratios' range over the rounds in brackets\n")
+    print(f"| volume (FE triangles) | FE | Steps 1–3 | embedded | paper | **embedded / FE** | Step 4 cost | normals: ours / FE's "
+          f"| FE, {all_t} threads | embedded, {all_t} threads | speed-up: ours / FE's | **embedded / FE, {all_t} threads** |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for g in groups:
-        arr, iso = volume(g)
-        fe1, tris = flying_edges(arr, iso, 1, a.repeat)
-        fe_all, _ = flying_edges(arr, iso, all_t, a.repeat)
-        fe_n, _ = flying_edges(arr, iso, 1, a.repeat, normals=True)
-        s1, e1, p1, en = (criterion_ms(g, f, 1) for f in ("steps123", "embedded", "paper", "embedded-normals"))
-        e_all = criterion_ms(g, "embedded", all_t)
-        if None in (s1, e1, p1, en, e_all):
+        rs = runs[g]
+        if not rs:
             print(f"| {g} | missing criterion results |")
             continue
-        rows.append((g, tris))
-        print(f"| {g} ({tris:,}) | {fe1:.1f} | {s1:.1f} | {e1:.1f} | {p1:.1f} | **{e1 / fe1:.2f}×** | {100 * (e1 / s1 - 1):+.0f}% "
-              f"| {100 * (en / e1 - 1):+.0f}% / {100 * (fe_n / fe1 - 1):+.0f}% | {fe_all:.1f} | {e_all:.1f} "
-              f"| {e1 / e_all:.2f}× / {fe1 / fe_all:.2f}× | **{e_all / fe_all:.2f}×** |")
+        rows.append(g)
+        med = lambda f: statistics.median(f(t) for t in rs)
+        span = lambda f: f"{min(f(t) for t in rs):.2f}–{max(f(t) for t in rs):.2f}"
+        one = lambda t: t["embedded"] / t["fe"]
+        two = lambda t: t["embedded-all"] / t["fe-all"]
+        print(f"| {g} ({rs[0]['tris']:,}) | {med(lambda t: t['fe']):.1f} | {med(lambda t: t['steps123']):.1f} "
+              f"| {med(lambda t: t['embedded']):.1f} | {med(lambda t: t['paper']):.1f} "
+              f"| **{med(one):.2f}×** ({span(one)}) | {100 * (med(lambda t: t['embedded'] / t['steps123']) - 1):+.0f}% "
+              f"| {100 * (med(lambda t: t['embedded-normals'] / t['embedded']) - 1):+.0f}% / "
+              f"{100 * (med(lambda t: t['fe-normals'] / t['fe']) - 1):+.0f}% "
+              f"| {med(lambda t: t['fe-all']):.1f} | {med(lambda t: t['embedded-all']):.1f} "
+              f"| {med(lambda t: t['embedded'] / t['embedded-all']):.2f}× / {med(lambda t: t['fe'] / t['fe-all']):.2f}× "
+              f"| **{med(two):.2f}×** ({span(two)}) |")
     print("\n| volume | triangles (embedded) | whole `skelclimb extract` | its extraction | **ratio** |")
     print("|---|---|---|---|---|")
-    for g, _ in rows:
+    for g in rows:
         t = process_times(g, a.repeat)
         if t:
             print(f"| {g} | {t[2]:,} | {t[0]:.1f} | {t[1]:.1f} | **{t[0] / t[1]:.2f}×** |")

@@ -6,6 +6,10 @@
 //! suggested value), such as the project's shared data and what `bench/derive_volumes.py` makes
 //! of it. Without it those benchmarks are skipped with a notice. `bench/compare.py` runs these
 //! and VTK's FlyingEdges in one go.
+//!
+//! `SC_BENCH_ONLY=<group>` (say `stent-ct@281`) builds and loads that volume alone: criterion's
+//! own filter skips the timing of the others but not the making of their volumes, which takes
+//! seconds. `bench/compare.py` runs one group at a time, alternating with Flying Edges.
 
 use std::path::Path;
 use std::time::Duration;
@@ -26,7 +30,7 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
     group
         .sample_size(10)
         .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(3));
+        .measurement_time(Duration::from_millis(1500));
     let threads = if all > 1 { vec![1, all] } else { vec![1] };
     let runs = MODES
         .iter()
@@ -48,6 +52,11 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
     group.finish();
 }
 
+/// Whether `SC_BENCH_ONLY` leaves the group `name` in.
+fn wanted(name: &str) -> bool {
+    std::env::var("SC_BENCH_ONLY").map_or(true, |only| only == name)
+}
+
 fn synthetic(c: &mut Criterion) {
     let to_f32 = |v: demo::DemoVolume| {
         (
@@ -56,12 +65,14 @@ fn synthetic(c: &mut Criterion) {
             v.iso,
         )
     };
-    for (name, v) in [
-        ("sphere-256", demo::sphere(256)),
-        ("knot-256", demo::knot(256)),
-        ("noise-256", demo::sphere_noise(256)),
-    ] {
-        let (data, dims, iso) = to_f32(v);
+    type Make = fn(usize) -> demo::DemoVolume;
+    let volumes: [(&str, Make); 3] = [
+        ("sphere-256", demo::sphere),
+        ("knot-256", demo::knot),
+        ("noise-256", demo::sphere_noise),
+    ];
+    for (name, make) in volumes.into_iter().filter(|(name, _)| wanted(name)) {
+        let (data, dims, iso) = to_f32(make(256));
         bench_volume(c, name, &data, dims, iso);
     }
 }
@@ -85,20 +96,38 @@ fn real(c: &mut Criterion) {
             .to_string_lossy()
             .into_owned();
         let json = d.join(format!("{stem}.json"));
-        match load(&json) {
-            Ok((meta, raw)) => {
-                for &iso in &meta.isos {
-                    let (name, dims) = (format!("{stem}@{iso}"), meta.dims);
-                    match meta.dtype.as_str() {
-                        "u8" => bench_volume(c, &name, &raw, dims, iso),
-                        "i16" => bench_volume(c, &name, &cast(&raw, i16::from_le_bytes), dims, iso),
-                        "u16" => bench_volume(c, &name, &cast(&raw, u16::from_le_bytes), dims, iso),
-                        "f32" => bench_volume(c, &name, &cast(&raw, f32::from_le_bytes), dims, iso),
-                        other => eprintln!("{}: dtype {other} not benchmarked", json.display()),
-                    }
-                }
+        let meta = match load(&json) {
+            Ok(meta) => meta,
+            Err(e) => {
+                eprintln!("skipping {}: {e}", json.display());
+                continue;
             }
-            Err(e) => eprintln!("skipping {}: {e}", json.display()),
+        };
+        let groups: Vec<(String, f64)> = meta
+            .isos
+            .iter()
+            .map(|&iso| (format!("{stem}@{iso}"), iso))
+            .filter(|(name, _)| wanted(name))
+            .collect();
+        if groups.is_empty() {
+            continue;
+        }
+        let raw = match std::fs::read(json.with_extension("raw")) {
+            Ok(raw) => raw,
+            Err(e) => {
+                eprintln!("skipping {}: {e}", json.display());
+                continue;
+            }
+        };
+        for (name, iso) in groups {
+            let dims = meta.dims;
+            match meta.dtype.as_str() {
+                "u8" => bench_volume(c, &name, &raw, dims, iso),
+                "i16" => bench_volume(c, &name, &cast(&raw, i16::from_le_bytes), dims, iso),
+                "u16" => bench_volume(c, &name, &cast(&raw, u16::from_le_bytes), dims, iso),
+                "f32" => bench_volume(c, &name, &cast(&raw, f32::from_le_bytes), dims, iso),
+                other => eprintln!("{}: dtype {other} not benchmarked", json.display()),
+            }
         }
     }
 }
@@ -109,8 +138,8 @@ struct Meta {
     isos: Vec<f64>,
 }
 
-/// Reads a volume's description (its suggested iso values) and raw samples.
-fn load(json: &Path) -> Result<(Meta, Vec<u8>), String> {
+/// Reads a volume's description: its dims, dtype and suggested iso values.
+fn load(json: &Path) -> Result<Meta, String> {
     let text = std::fs::read_to_string(json).map_err(|e| e.to_string())?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
     let dims: Vec<usize> = v["dims"]
@@ -128,15 +157,11 @@ fn load(json: &Path) -> Result<(Meta, Vec<u8>), String> {
         return Err("no iso".into());
     }
     let dtype = v["dtype"].as_str().ok_or("no dtype")?.to_string();
-    let raw = std::fs::read(json.with_extension("raw")).map_err(|e| e.to_string())?;
-    Ok((
-        Meta {
-            dims: dims.try_into().map_err(|_| "dims need 3 values")?,
-            dtype,
-            isos,
-        },
-        raw,
-    ))
+    Ok(Meta {
+        dims: dims.try_into().map_err(|_| "dims need 3 values")?,
+        dtype,
+        isos,
+    })
 }
 
 fn cast<T, const N: usize>(raw: &[u8], f: fn([u8; N]) -> T) -> Vec<T> {
