@@ -15,7 +15,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use sc_runtime::{Mode, Params, Scalar, Volume, demo, extract_par};
+use sc_runtime::{Extractor, Mode, Params, Scalar, Volume, demo, extract_par};
 
 const MODES: [(Mode, &str); 3] = [
     (Mode::Steps123, "steps123"),
@@ -49,6 +49,22 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
             |b, &t| b.iter(|| extract_par(&vol, &params, t, &|_| {}).expect("extraction succeeds")),
         );
     }
+    // The same with normals through an `Extractor`, which keeps its buffers between calls: what
+    // the allocator costs the line above (see the README's "Repeated extractions and glibc").
+    let params = Params {
+        normals: true,
+        ..Params::new(iso)
+    };
+    let mut extractor = Extractor::new();
+    group.bench_function(BenchmarkId::new("embedded-normals-reused", "1t"), |b| {
+        b.iter(|| {
+            extractor
+                .extract(&vol, &params)
+                .expect("extraction succeeds")
+                .triangles
+                .len()
+        })
+    });
     group.finish();
 }
 

@@ -32,6 +32,10 @@ mod mesh;
 #[cfg(feature = "alloc")]
 pub use mesh::{Mesh, extract};
 #[cfg(feature = "alloc")]
+mod extractor;
+#[cfg(feature = "alloc")]
+pub use extractor::Extractor;
+#[cfg(feature = "alloc")]
 mod block;
 #[cfg(feature = "alloc")]
 mod survey;

@@ -1,9 +1,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::extract::{InMemory, has_cubes};
-use crate::survey::Survey;
-use crate::{Error, Params, Scalar, Scratch, Sink, Stats, Volume, extract_into};
+use crate::{Error, Extractor, Params, Scalar, Scratch, Sink, Stats, Volume};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -92,6 +90,7 @@ impl Sink for Presized<'_> {
 }
 
 /// Scratch buffers owned on the heap.
+#[derive(Default)]
 pub(crate) struct OwnedScratch {
     bytes: Vec<u8>,
     words: Vec<u32>,
@@ -106,6 +105,19 @@ impl OwnedScratch {
         })
     }
 
+    /// Sizes the buffers for `dims`, keeping their memory: fresh buffers are allocated zeroed,
+    /// which leaves pages the sweep never touches untouched.
+    pub fn fit(&mut self, dims: [usize; 3]) -> Result<(), Error> {
+        let len = Scratch::len(dims)?;
+        if self.bytes.capacity() < len.bytes || self.words.capacity() < len.words {
+            *self = OwnedScratch::new(dims)?;
+        } else {
+            self.bytes.resize(len.bytes, 0);
+            self.words.resize(len.words, 0);
+        }
+        Ok(())
+    }
+
     pub fn lend(&mut self) -> Scratch<'_> {
         Scratch {
             bytes: &mut self.bytes,
@@ -114,7 +126,8 @@ impl OwnedScratch {
     }
 }
 
-/// Extracts the surface on one thread.
+/// Extracts the surface on one thread. To extract again and again, an [`Extractor`] keeps the
+/// buffers between calls.
 ///
 /// ```
 /// use sc_runtime::{Params, Volume, demo, extract};
@@ -125,19 +138,9 @@ impl OwnedScratch {
 /// assert_eq!(mesh.stats.t13, 13_968); // the paper's Table 1, Steps 1–3
 /// ```
 pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
-    let dims = volume.dims();
-    let mut scratch = OwnedScratch::new(dims)?;
-    let mut mesh = Mesh::default();
-    if has_cubes(dims) {
-        let src = InMemory {
-            data: volume.data(),
-            nxy: dims[0] * dims[1],
-        };
-        let survey = Survey::new(&src, dims, T::threshold(params.iso));
-        mesh.reserve_for(survey.between(0, dims[2]), params.normals);
-    }
-    mesh.stats = extract_into(volume, params, scratch.lend(), &mut Presized(&mut mesh))?;
-    Ok(mesh)
+    let mut extractor = Extractor::new();
+    extractor.extract(volume, params)?;
+    Ok(extractor.into_mesh())
 }
 
 /// Asks the kernel to back a large buffer with 2 MiB pages, before it is first touched.
