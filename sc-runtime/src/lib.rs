@@ -30,11 +30,11 @@ pub use stats::Stats;
 #[cfg(feature = "alloc")]
 mod mesh;
 #[cfg(feature = "alloc")]
-pub use mesh::{Mesh, extract};
+pub use mesh::Mesh;
 #[cfg(feature = "alloc")]
 mod extractor;
 #[cfg(feature = "alloc")]
-pub use extractor::Extractor;
+pub use extractor::{Extractor, extract};
 #[cfg(feature = "alloc")]
 mod block;
 #[cfg(feature = "alloc")]
@@ -53,6 +53,10 @@ pub mod demo;
 mod parallel;
 #[cfg(feature = "std")]
 pub use parallel::extract_par;
+#[cfg(feature = "std")]
+mod region;
+#[cfg(feature = "std")]
+mod spare;
 
 mod scratch;
 mod sink;

@@ -1,7 +1,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::{Error, Extractor, Params, Scalar, Scratch, Sink, Stats, Volume};
+use crate::{Error, Scratch, Sink, Stats};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -22,21 +22,22 @@ impl Mesh {
     /// cost address space, not memory. The margin, half as much again, covers estimates down to
     /// two thirds of the count, and the survey's are within 0.90–1.01 on the benchmark volumes.
     pub(crate) fn reserve_for(&mut self, vertices: usize, normals: bool) {
-        let v = vertices + vertices / 2;
+        let v = Self::room_for(vertices);
         self.positions.reserve_exact(v);
         if normals {
             self.normals.reserve_exact(v);
         }
         // A closed surface has about two triangles per vertex before merging.
         self.triangles.reserve_exact(2 * v);
-        self.advise_huge_pages();
-    }
-
-    /// [`huge_pages`] for each buffer, before any is first touched.
-    pub(crate) fn advise_huge_pages(&mut self) {
         huge_pages(&mut self.positions);
         huge_pages(&mut self.normals);
         huge_pages(&mut self.triangles);
+    }
+
+    /// The vertices to reserve room for, for a survey's estimate of `vertices`; twice as many
+    /// triangles.
+    pub(crate) fn room_for(vertices: usize) -> usize {
+        vertices + vertices / 2
     }
 }
 
@@ -118,6 +119,12 @@ impl OwnedScratch {
         Ok(())
     }
 
+    /// Bytes held.
+    #[cfg(feature = "std")]
+    pub fn bytes(&self) -> usize {
+        self.bytes.capacity() + core::mem::size_of::<u32>() * self.words.capacity()
+    }
+
     pub fn lend(&mut self) -> Scratch<'_> {
         Scratch {
             bytes: &mut self.bytes,
@@ -126,26 +133,9 @@ impl OwnedScratch {
     }
 }
 
-/// Extracts the surface on one thread. To extract again and again, an [`Extractor`] keeps the
-/// buffers between calls.
-///
-/// ```
-/// use sc_runtime::{Params, Volume, demo, extract};
-///
-/// let knot = demo::knot(64);
-/// let params = Params { spacing: knot.spacing, origin: knot.origin, ..Params::new(knot.iso) };
-/// let mesh = extract(&Volume::new(&knot.data, knot.dims).unwrap(), &params).unwrap();
-/// assert_eq!(mesh.stats.t13, 13_968); // the paper's Table 1, Steps 1–3
-/// ```
-pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
-    let mut extractor = Extractor::new();
-    extractor.extract(volume, params)?;
-    Ok(extractor.into_mesh())
-}
-
 /// Asks the kernel to back a large buffer with 2 MiB pages, before it is first touched.
 #[cfg(all(feature = "std", target_os = "linux"))]
-fn huge_pages<T>(v: &mut Vec<T>) {
+pub(crate) fn huge_pages<T>(v: &mut Vec<T>) {
     const HUGE: usize = 2 << 20;
     let bytes = v.capacity() * core::mem::size_of::<T>();
     if bytes < 2 * HUGE {
@@ -168,7 +158,7 @@ fn huge_pages<T>(v: &mut Vec<T>) {
 }
 
 #[cfg(not(all(feature = "std", target_os = "linux")))]
-fn huge_pages<T>(_: &mut Vec<T>) {}
+pub(crate) fn huge_pages<T>(_: &mut Vec<T>) {}
 
 #[cfg(test)]
 mod tests {

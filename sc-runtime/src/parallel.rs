@@ -5,26 +5,58 @@ use std::vec::Vec;
 use rayon::prelude::*;
 
 use crate::extract::{InMemory, has_cubes};
-use crate::mesh::{OwnedScratch, Presized};
+use crate::region::{self, Filled, Stretch};
+use crate::spare::SPARES;
 use crate::survey::{self, Survey};
 use crate::sweep::Sweep;
-use crate::{Error, Mesh, Params, Scalar, Stats, Volume};
+use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
 
 /// Layers per chunk at least: a chunk re-reads up to three slices of its neighbour, so tiny
 /// chunks waste work.
 const MIN_CHUNK_LAYERS: usize = 8;
 
+/// Where a chunk writes: its stretches of the output's vectors.
+struct Region<'a> {
+    positions: Stretch<'a, [f32; 3]>,
+    normals: Stretch<'a, [f32; 3]>,
+    triangles: Stretch<'a, [u32; 3]>,
+}
+
+impl Sink for Region<'_> {
+    #[inline]
+    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
+        self.positions.push(position);
+        if let Some(n) = normal {
+            self.normals.push(n);
+        }
+    }
+
+    #[inline]
+    fn triangle(&mut self, triangle: [u32; 3]) {
+        self.triangles.push(triangle);
+    }
+}
+
 /// One chunk's output, with vertex ids local to the chunk. Ids below `first_plane` belong to the
 /// previous chunk's last plane, which this chunk numbered but did not emit.
 struct Part {
-    mesh: Mesh,
+    positions: Filled<[f32; 3]>,
+    normals: Filled<[f32; 3]>,
+    triangles: Filled<[u32; 3]>,
+    vertices: usize,
     first_plane: u32,
+    stats: Stats,
 }
 
 /// Extracts the surface on `threads` threads (0 = all cores). The z range is cut into chunks of
 /// layers; each chunk numbers vertices exactly as a full sweep would, offset by a constant, so
 /// stitching is an addition and the mesh is byte-identical to [`crate::extract`]'s for any thread
 /// count. `progress` is called with the number of z layers just finished.
+///
+/// Each thread's scratch (about 13 bytes per sample of one z-slice) is kept for the next
+/// extraction, this one's or [`crate::extract`]'s, up to 64 MiB in all: allocated afresh, it
+/// made glibc hand the heap back to the kernel after every call and fault it in again on the
+/// next, which doubled the time of small extractions.
 ///
 /// ```
 /// use sc_runtime::{Params, Volume, demo, extract, extract_par};
@@ -85,49 +117,72 @@ pub fn extract_par<T: Scalar>(
             .collect(),
     );
     let bounds = balanced_bounds(&survey, dims, chunks);
-    // The chunks' meshes and the workers' scratch are allocated here, not on the workers: glibc
-    // gives each worker thread an arena of its own and returns what is freed there to the
-    // kernel, so every extraction faulted those pages in again (on the MNI brain's white matter,
-    // 3,100 page faults per two-thread extraction; 670 allocated here). One scratch per worker,
-    // indexed by the worker's index, so that no two running chunks share one.
-    let meshes: Vec<Mesh> = bounds
+    // One output, each chunk writing into its own stretch of it (see `region`), and scratch
+    // from the spares: an extraction allocates what a one-thread one does. Both are taken here,
+    // not on the workers: glibc gives each worker thread an arena of its own and returns what
+    // is freed there to the kernel. One scratch per worker, indexed by the worker's index, so
+    // that no two running chunks share one.
+    let room: Vec<usize> = bounds
         .iter()
-        .map(|&(z0, z1)| {
-            let mut mesh = Mesh::default();
-            mesh.reserve_for(survey.between(z0, z1 + 1), params.normals);
-            mesh
+        .map(|&(z0, z1)| Mesh::room_for(survey.between(z0, z1 + 1)))
+        .collect();
+    let normal_room = if params.normals {
+        room.clone()
+    } else {
+        vec![0; room.len()]
+    };
+    let triangle_room: Vec<usize> = room.iter().map(|&v| 2 * v).collect();
+    let mut out = Mesh::default();
+    let regions: Vec<Region<'_>> = region::stretches(&mut out.positions, &room)
+        .into_iter()
+        .zip(region::stretches(&mut out.normals, &normal_room))
+        .zip(region::stretches(&mut out.triangles, &triangle_room))
+        .map(|((positions, normals), triangles)| Region {
+            positions,
+            normals,
+            triangles,
         })
         .collect();
     let scratches = (0..workers)
-        .map(|_| OwnedScratch::new(dims).map(Mutex::new))
+        .map(|_| SPARES.take(dims).map(Mutex::new))
         .collect::<Result<Vec<_>, _>>()?;
     let run = || {
-        let parts: Vec<Result<Part, Error>> = bounds
+        bounds
             .par_iter()
-            .zip(meshes)
-            .map(|(&(z0, z1), mut mesh)| {
+            .zip(regions)
+            .map(|(&(z0, z1), mut region)| {
                 // Each worker takes the scratch of its own index: the lock is never contended.
                 // A poisoned lock means a worker panicked, and that panic is on its way.
                 let slot = rayon::current_thread_index().unwrap_or(0) % scratches.len();
                 let mut scratch = scratches[slot].lock().unwrap_or_else(|p| p.into_inner());
                 let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
-                let sink = &mut Presized(&mut mesh);
-                sweep.start(z0, &src, sink, z0 == 0)?;
+                sweep.start(z0, &src, &mut region, z0 == 0)?;
                 let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
                 for k in z0..z1 {
-                    sweep.layer(k, &src, sink)?;
+                    sweep.layer(k, &src, &mut region)?;
                     progress(1);
                 }
-                mesh.stats = sweep.stats();
-                Ok(Part { mesh, first_plane })
+                Ok(Part {
+                    vertices: region.positions.len(),
+                    positions: region.positions.finish(),
+                    normals: region.normals.finish(),
+                    triangles: region.triangles.finish(),
+                    first_plane,
+                    stats: sweep.stats(),
+                })
             })
-            .collect();
-        stitch(parts.into_iter().collect::<Result<Vec<_>, _>>()?)
+            .collect::<Result<Vec<Part>, Error>>()
     };
-    match own_pool {
+    let parts = match own_pool {
         Some(pool) => pool.install(run),
         None => run(),
+    };
+    for scratch in scratches {
+        SPARES.give(scratch.into_inner().unwrap_or_else(|p| p.into_inner()));
     }
+    let parts = parts?;
+    stitch(&mut out, parts)?;
+    Ok(out)
 }
 
 /// What one estimated vertex costs, in units of one sample's fixed cost (classifying it, its
@@ -157,49 +212,34 @@ fn balanced_bounds(survey: &Survey, dims: [usize; 3], chunks: usize) -> Vec<(usi
     bounds
 }
 
-/// Concatenates chunk meshes, shifting each chunk's ids by its start in the global order. The
-/// output is allocated zeroed (pages the kernel provides lazily) and filled in parallel.
-fn stitch(parts: Vec<Part>) -> Result<Mesh, Error> {
-    let total_v: usize = parts.iter().map(|p| p.mesh.positions.len()).sum();
-    let total_n: usize = parts.iter().map(|p| p.mesh.normals.len()).sum();
-    let total_t: usize = parts.iter().map(|p| p.mesh.triangles.len()).sum();
+/// Joins the chunks' stretches of `out`, shifting each chunk's ids by its start in the global
+/// order: its id `first_plane` is the first vertex it emitted.
+fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
+    let total_v: usize = parts.iter().map(|p| p.vertices).sum();
     if u32::try_from(total_v).is_err() {
         return Err(Error::TooManyVertices);
     }
-    let mut out = Mesh {
-        positions: vec![[0.0; 3]; total_v],
-        normals: vec![[0.0; 3]; total_n],
-        triangles: vec![[0; 3]; total_t],
-        stats: Stats::default(),
-    };
-    out.advise_huge_pages();
-    // Each chunk's destination slices, and the shift that makes its ids global: its id
-    // `first_plane` is the first vertex it emitted.
-    let mut jobs = Vec::with_capacity(parts.len());
-    let (mut pos, mut nor, mut tri) = (
-        &mut out.positions[..],
-        &mut out.normals[..],
-        &mut out.triangles[..],
-    );
+    out.stats = parts.iter().fold(Stats::default(), |s, p| s + p.stats);
     let mut emitted = 0u32;
-    for part in &parts {
-        let m = &part.mesh;
-        let (p, rest_p) = core::mem::take(&mut pos).split_at_mut(m.positions.len());
-        let (n, rest_n) = core::mem::take(&mut nor).split_at_mut(m.normals.len());
-        let (t, rest_t) = core::mem::take(&mut tri).split_at_mut(m.triangles.len());
-        (pos, nor, tri) = (rest_p, rest_n, rest_t);
-        jobs.push((part, p, n, t, emitted - part.first_plane));
-        emitted += m.positions.len() as u32;
+    let mut shifts = Vec::with_capacity(parts.len());
+    let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+    for p in parts {
+        shifts.push(emitted - p.first_plane);
+        emitted += p.vertices as u32;
+        positions.push(p.positions);
+        normals.push(p.normals);
+        triangles.push(p.triangles);
     }
-    jobs.into_par_iter().for_each(|(part, p, n, t, shift)| {
-        p.copy_from_slice(&part.mesh.positions);
-        n.copy_from_slice(&part.mesh.normals);
-        for (d, s) in t.iter_mut().zip(&part.mesh.triangles) {
-            *d = s.map(|i| i + shift);
-        }
-    });
-    out.stats = parts.iter().fold(Stats::default(), |s, p| s + p.mesh.stats);
-    Ok(out)
+    // SAFETY: each list is the finished stretches of that vector, all of them, in order (one
+    // part per stretch, as `extract_par` made them), and nothing touched the vectors since.
+    unsafe {
+        region::join(&mut out.positions, &positions, |_, x| x);
+        region::join(&mut out.normals, &normals, |_, x| x);
+        region::join(&mut out.triangles, &triangles, |i, t| {
+            t.map(|v| v + shifts[i])
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
