@@ -5,6 +5,7 @@ use std::vec::Vec;
 use rayon::prelude::*;
 
 use crate::extract::{InMemory, has_cubes};
+use crate::mesh::release_spare;
 use crate::region::{self, Filled, Stretch};
 use crate::spare::SPARES;
 use crate::survey::{self, Survey};
@@ -233,12 +234,17 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
     // SAFETY: each list is the finished stretches of that vector, all of them, in order (one
     // part per stretch, as `extract_par` made them), and nothing touched the vectors since.
     unsafe {
-        region::join(&mut out.positions, &positions, |_, x| x);
-        region::join(&mut out.normals, &normals, |_, x| x);
+        region::join(&mut out.positions, &positions, |_, _| {});
+        region::join(&mut out.normals, &normals, |_, _| {});
         region::join(&mut out.triangles, &triangles, |i, t| {
-            t.map(|v| v + shifts[i])
+            t.as_flattened_mut()
+                .iter_mut()
+                .for_each(|v| *v += shifts[i]);
         });
     }
+    release_spare(&mut out.positions);
+    release_spare(&mut out.normals);
+    release_spare(&mut out.triangles);
     Ok(())
 }
 

@@ -11,6 +11,8 @@
 use alloc::vec::Vec;
 use core::mem::MaybeUninit;
 
+use rayon::prelude::*;
+
 #[cfg(doc)]
 use crate::Mesh;
 use crate::mesh::huge_pages;
@@ -81,16 +83,16 @@ pub(crate) fn stretches<'a, T>(buf: &'a mut Vec<T>, lens: &[usize]) -> Vec<Stret
         .collect()
 }
 
-/// Makes `buf` the concatenation of `parts` in order, each element passed through `map` with
-/// its part's index.
+/// Makes `buf` the concatenation of `parts` in order, each part first passed to `adjust` with
+/// its index.
 ///
 /// # Safety
 /// `parts` are the finished stretches of [`stretches`] on this `buf`, all of them, in order, and
 /// `buf` has not been touched since.
-pub(crate) unsafe fn join<T: Copy>(
+pub(crate) unsafe fn join<T: Copy + Send>(
     buf: &mut Vec<T>,
     parts: &[Filled<T>],
-    map: impl Fn(usize, T) -> T,
+    adjust: impl Fn(usize, &mut [T]) + Sync,
 ) {
     let total: usize = parts.iter().map(|p| p.len + p.spill.len()).sum();
     if parts.iter().any(|p| !p.spill.is_empty()) {
@@ -99,21 +101,30 @@ pub(crate) unsafe fn join<T: Copy>(
         for (i, p) in parts.iter().enumerate() {
             // SAFETY: the stretch's first `len` elements were written (the caller's contract).
             let written = unsafe { core::slice::from_raw_parts(buf.as_ptr().add(p.start), p.len) };
-            joined.extend(written.iter().chain(&p.spill).map(|&x| map(i, x)));
+            let from = joined.len();
+            joined.extend_from_slice(written);
+            joined.extend_from_slice(&p.spill);
+            adjust(i, &mut joined[from..]);
         }
         *buf = joined;
         return;
     }
     let base = buf.as_mut_ptr();
+    // SAFETY: each part's first `len` elements were written, and the stretches are disjoint.
+    let written: Vec<&mut [T]> = parts
+        .iter()
+        .map(|p| unsafe { core::slice::from_raw_parts_mut(base.add(p.start), p.len) })
+        .collect();
+    written
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(i, part)| adjust(i, part));
     let mut to = 0;
-    for (i, p) in parts.iter().enumerate() {
-        // Stretches start at the sum of the lengths before them, so `to <= p.start`: moving
-        // forwards element by element never overwrites one not yet read.
-        for k in 0..p.len {
-            // SAFETY: both indices lie within the capacity; the source was written, and the
-            // destination is either it or already moved (see above).
-            unsafe { base.add(to + k).write(map(i, base.add(p.start + k).read())) };
-        }
+    for p in parts {
+        // SAFETY: stretches start at the sum of the room before them, at or past the sum of
+        // the lengths before them (`to`): both ranges lie within the capacity, and `copy` is
+        // `memmove`, which allows them to overlap.
+        unsafe { core::ptr::copy(base.add(p.start), base.add(to), p.len) };
         to += p.len;
     }
     // SAFETY: the first `total` elements are now the parts' elements, all initialised.
@@ -148,7 +159,11 @@ mod tests {
             }
             let filled: Vec<_> = parts.into_iter().map(|p| p.finish()).collect();
             // SAFETY: all the stretches of `buf`, finished, in order.
-            unsafe { join(&mut buf, &filled, |i, x| x + i as u32) };
+            unsafe {
+                join(&mut buf, &filled, |i, xs| {
+                    xs.iter_mut().for_each(|x| *x += i as u32)
+                })
+            };
             assert_eq!(buf, want, "{lens:?} {counts:?}");
         }
     }
