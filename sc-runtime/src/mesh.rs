@@ -153,9 +153,11 @@ pub(crate) fn huge_pages<T>(v: &mut Vec<T>) {
 #[cfg(all(feature = "std", target_os = "linux"))]
 pub(crate) fn release_spare<T>(v: &mut Vec<T>) {
     if (v.capacity() - v.len()) * core::mem::size_of::<T>() >= ADVISE_FROM {
+        // SAFETY: sysconf has no preconditions.
+        let page = usize::try_from(unsafe { libc::sysconf(libc::_SC_PAGESIZE) }).unwrap_or(4096);
         // SAFETY: nothing lives past the vector's length, and Rust treats that room as
         // uninitialised, so its pages reading as zeros afterwards (MADV_DONTNEED) is invisible.
-        unsafe { advise(v, v.len(), 4096, libc::MADV_DONTNEED) };
+        unsafe { advise(v, v.len(), page, libc::MADV_DONTNEED) };
     }
 }
 
@@ -217,5 +219,37 @@ mod tests {
         );
         assert_eq!(mesh.positions.capacity(), reserved);
         assert_eq!(mesh.triangles.capacity(), 2 * reserved);
+    }
+
+    /// A vector with 8 MiB of spare room, all of it written: after `release_spare` its elements
+    /// are intact and the spare room's whole pages are no longer resident (`mincore`).
+    #[cfg(all(feature = "std", target_os = "linux"))]
+    #[test]
+    fn released_spare_room_leaves_the_elements_and_drops_the_pages() {
+        let len = 1 << 20;
+        let mut v: Vec<u32> = Vec::with_capacity(3 * len);
+        v.extend((0..3 * len as u32).map(|i| i.wrapping_mul(2_654_435_761)));
+        v.truncate(len);
+        super::release_spare(&mut v);
+        assert!(
+            v.iter()
+                .enumerate()
+                .all(|(i, &x)| x == (i as u32).wrapping_mul(2_654_435_761))
+        );
+        let page = 4096;
+        let start = (v.as_ptr() as usize + 4 * len).next_multiple_of(page);
+        let end = (v.as_ptr() as usize + 4 * v.capacity()) / page * page;
+        let mut resident = std::vec![0u8; (end - start) / page];
+        // SAFETY: the range lies within the vector's allocation, and `resident` has a byte per
+        // page of it.
+        let ok = unsafe {
+            libc::mincore(
+                start as *mut libc::c_void,
+                end - start,
+                resident.as_mut_ptr(),
+            )
+        };
+        assert_eq!(ok, 0);
+        assert!(resident.iter().all(|&r| r & 1 == 0));
     }
 }

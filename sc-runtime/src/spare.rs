@@ -5,7 +5,8 @@
 //! returning the heap's top to the kernel after each call, so that the next call faulted every
 //! page of its mesh in again: on a 256 × 256 × 20 MRI, two threads' two scratches made 1,350 page
 //! faults per extraction and doubled its time (3.8 → 7–9 ms); with normals on one thread, on the
-//! 128 × 128 × 84 MRI, 6.7 → 5.0 ms. Kept here, an extraction allocates only its mesh.
+//! 128 × 128 × 84 MRI after other extractions in the same process, 6.7 → 5.0 ms. Kept here, an
+//! extraction allocates only its mesh.
 
 use std::sync::Mutex;
 use std::vec::Vec;
