@@ -41,19 +41,30 @@ impl Mesh {
     }
 }
 
-impl Sink for Mesh {
-    #[inline]
-    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
-        self.positions.push(position);
-        if let Some(n) = normal {
-            self.normals.push(n);
+/// [`Sink::vertex`] and [`Sink::triangle`] for a type with `positions`, `normals` and
+/// `triangles` fields that each have a `push`: the mesh's vectors, and a parallel chunk's
+/// stretches of them.
+macro_rules! push_to_columns {
+    () => {
+        #[inline]
+        fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
+            self.positions.push(position);
+            if let Some(n) = normal {
+                self.normals.push(n);
+            }
         }
-    }
 
-    #[inline]
-    fn triangle(&mut self, triangle: [u32; 3]) {
-        self.triangles.push(triangle);
-    }
+        #[inline]
+        fn triangle(&mut self, triangle: [u32; 3]) {
+            self.triangles.push(triangle);
+        }
+    };
+}
+#[cfg(feature = "std")]
+pub(crate) use push_to_columns;
+
+impl Sink for Mesh {
+    push_to_columns!();
 
     fn expect(&mut self, vertices: usize, triangles: usize) {
         // Reserve with a quarter to spare, and only when the hint outgrows the capacity, so the

@@ -5,7 +5,7 @@ use std::vec::Vec;
 use rayon::prelude::*;
 
 use crate::extract::{InMemory, has_cubes};
-use crate::mesh::release_spare;
+use crate::mesh::{push_to_columns, release_spare};
 use crate::region::{self, Filled, Stretch};
 use crate::spare::SPARES;
 use crate::survey::{self, Survey};
@@ -24,18 +24,7 @@ struct Region<'a> {
 }
 
 impl Sink for Region<'_> {
-    #[inline]
-    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
-        self.positions.push(position);
-        if let Some(n) = normal {
-            self.normals.push(n);
-        }
-    }
-
-    #[inline]
-    fn triangle(&mut self, triangle: [u32; 3]) {
-        self.triangles.push(triangle);
-    }
+    push_to_columns!();
 }
 
 /// One chunk's output, with vertex ids local to the chunk. Ids below `first_plane` belong to the
