@@ -595,32 +595,15 @@ impl Grid<'_> {
             if lo >= hi {
                 continue;
             }
-            // Eight cubes at a time, from the four sample rows' words at `x` and `x + 1`: the
-            // samples are 0 or 1, so no bit crosses into the next byte. Zips over each row
-            // vectorised, but every row paid a scalar tail and its loop's exit mispredicted
-            // (a tenth of brainsmall's simulated mispredictions). The rows run past `hi` into
-            // the next row or the padding (`8 · chunks + 1 ≤ hi − lo + 8`).
+            // The rows run past `hi` into the next row or the padding (see `cube_cases`).
             let chunks = (hi - lo).div_ceil(8);
             let filled = &*self.filled;
             let row = |n: usize| {
                 let (y, z) = rows[n];
                 &filled[(z % 4) * nx * ny + y * nx + lo..][..8 * chunks + 1]
             };
-            let rows = [row(0), row(1), row(2), row(3)];
             let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..8 * chunks];
-            for (c, cell) in out.chunks_exact_mut(8).enumerate() {
-                let mut case = 0;
-                for (n, row) in rows.iter().enumerate() {
-                    case |= pairs(&row[8 * c..8 * c + 9]) << (2 * n);
-                }
-                if c + 1 == chunks {
-                    // Past the span: leave the next cubes' cases as they are.
-                    let keep = !within(hi - lo - 8 * c);
-                    let old = u64::from_le_bytes(cell.try_into().expect("eight bytes"));
-                    case = case & !keep | old & keep;
-                }
-                cell.copy_from_slice(&case.to_le_bytes());
-            }
+            cube_cases([row(0), row(1), row(2), row(3)], out, hi - lo);
         }
     }
 
@@ -812,6 +795,31 @@ fn within(left: usize) -> u64 {
     u64::MAX >> (8 * (8 - left))
 }
 
+/// The cases of cubes `0..len` into `out` (`8 · ⌈len / 8⌉` bytes; those from `len` on are left
+/// as they were), from their four sample rows — `y` and `y + 1` at `z`, then at `z + 1` — each at
+/// least one byte longer than `out`.
+///
+/// Eight cubes at a time, from each row's words at `x` and `x + 1`: the samples are 0 or 1, so no
+/// bit crosses into the next byte. Zips over each row vectorised, but every row paid a scalar tail
+/// and its loop's exit mispredicted (a tenth of brainsmall's simulated mispredictions).
+#[inline(always)]
+fn cube_cases(rows: [&[u8]; 4], out: &mut [u8], len: usize) {
+    let chunks = out.len() / 8;
+    for (c, cell) in out.chunks_exact_mut(8).enumerate() {
+        let mut case = 0;
+        for (n, row) in rows.iter().enumerate() {
+            case |= pairs(&row[8 * c..8 * c + 9]) << (2 * n);
+        }
+        if c + 1 == chunks {
+            // Past the span: leave the next cubes' cases as they are.
+            let keep = !within(len - 8 * c);
+            let old = u64::from_le_bytes(cell.try_into().expect("eight bytes"));
+            case = case & !keep | old & keep;
+        }
+        cell.copy_from_slice(&case.to_le_bytes());
+    }
+}
+
 /// Eight cube-edge pairs of a classified row, `row[x] | row[x + 1] << 1` in byte `x`, from its
 /// first nine bytes.
 #[inline(always)]
@@ -885,7 +893,8 @@ fn last_differing(row: &[u8], v: u8) -> Option<usize> {
 
 #[cfg(test)]
 mod tests {
-    use super::{for_each_crossed, for_each_differing};
+    use super::{cube_cases, for_each_crossed, for_each_differing};
+    use alloc::vec;
     use alloc::vec::Vec;
 
     /// Rows mixing runs of 0 and 255 with crossed cases at every position of an eight-byte word,
@@ -925,6 +934,39 @@ mod tests {
                     let mut seen = Vec::new();
                     for_each_crossed(&row, start, end, |x, case| seen.push((x, case)));
                     assert_eq!(seen, plain);
+                }
+            }
+        }
+    }
+
+    /// `cube_cases` gives every cube of `0..len` the case a cube-by-cube formula gives, for
+    /// every `len` up to 37 cubes, and leaves the bytes past `len` alone.
+    #[test]
+    fn cube_cases_match_a_plain_formula() {
+        let mut state = 0x853C_49E6_748F_EA9Bu64;
+        for _ in 0..50 {
+            let rows: Vec<Vec<u8>> = (0..4)
+                .map(|_| {
+                    (0..41)
+                        .map(|_| {
+                            state ^= state << 13;
+                            state ^= state >> 7;
+                            state ^= state << 17;
+                            (state >> 33) as u8 & 1
+                        })
+                        .collect()
+                })
+                .collect();
+            for len in 1usize..=37 {
+                let words = 8 * len.div_ceil(8);
+                let mut out = vec![0xAA; words];
+                let cut = |n: usize| &rows[n][..words + 1];
+                cube_cases([cut(0), cut(1), cut(2), cut(3)], &mut out, len);
+                for (x, &case) in out.iter().enumerate() {
+                    let plain =
+                        (0..4).fold(0, |c, n| c | (rows[n][x] | rows[n][x + 1] << 1) << (2 * n));
+                    let want = if x < len { plain } else { 0xAA };
+                    assert_eq!(case, want, "cube {x} of {len}");
                 }
             }
         }
