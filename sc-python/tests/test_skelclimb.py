@@ -51,7 +51,12 @@ def crop():
 
 
 def skelclimb_binary():
-    """This checkout's `skelclimb`, built if needed (never another one on the PATH)."""
+    """This checkout's `skelclimb`: `$SKELCLIMB_BIN` if set (CI passes the one `cargo test`
+    built), else the release one, built if needed (never another one on the PATH)."""
+    given = os.environ.get("SKELCLIMB_BIN")
+    if given:
+        assert Path(given).is_file(), f"SKELCLIMB_BIN={given} is not a file"
+        return given
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "sc-cli"], cwd=ROOT, check=True)
     return str(ROOT / "target" / "release" / "skelclimb")
 
