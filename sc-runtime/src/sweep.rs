@@ -11,6 +11,8 @@
 //! records where its x-edges change, and a cube row only visits the span where its four sample
 //! rows can disagree.
 
+use core::num::NonZeroU8;
+
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::Entry;
 use crate::vertex::{Field, sample_crossing};
@@ -368,8 +370,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                         sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
                 }
-                while kept != 0 {
-                    let n = kept.trailing_zeros() as usize;
+                // Five triangles at most: the mask says so to the compiler, which then drops
+                // the bounds check on `tris` (and the zero test of `trailing_zeros`).
+                kept &= (1 << entry.tris.len()) - 1;
+                while let Some(set) = NonZeroU8::new(kept) {
+                    let n = set.trailing_zeros() as usize;
                     kept &= kept - 1;
                     triangles += 1;
                     let [a, b, c] = entry.tris[n];
