@@ -27,17 +27,29 @@ impl Mesh {
         if normals {
             self.normals.reserve_exact(v);
         }
-        // A closed surface has about two triangles per vertex before merging.
-        self.triangles.reserve_exact(2 * v);
+        self.triangles.reserve_exact(Self::triangle_room(v));
         huge_pages(&mut self.positions);
         huge_pages(&mut self.normals);
         huge_pages(&mut self.triangles);
     }
 
-    /// The vertices to reserve room for, for a survey's estimate of `vertices`; twice as many
-    /// triangles.
+    /// The vertices to reserve room for, for a survey's estimate of `vertices`.
     pub(crate) fn room_for(vertices: usize) -> usize {
         vertices + vertices / 2
+    }
+
+    /// The triangles to reserve room for, next to room for `vertices` vertices: a closed surface
+    /// has about two triangles per vertex before merging, and we reserve two and a half. The
+    /// extra half keeps glibc from giving the heap back after every extraction with normals.
+    /// Once glibc has unmapped a freed block, it keeps later blocks of that size on the heap
+    /// and gives the heap's top back to the kernel when more than twice that size is free
+    /// there. At two triangles per vertex the triangles are exactly as large as the positions
+    /// and the normals together, so freeing a mesh with normals (and scikit-image's values,
+    /// in the Python package) left just over twice the triangles free, and the next extraction
+    /// faulted its pages in again: brainsmall in a loop 370 page faults per extraction, in
+    /// Python 700 per call. Untouched room costs address space, not memory.
+    pub(crate) fn triangle_room(vertices: usize) -> usize {
+        2 * vertices + vertices / 2
     }
 }
 
@@ -204,7 +216,8 @@ mod tests {
 
     /// A ball in the first quarter of the layers: after its first layers the sweep's hints
     /// extrapolate its surface over all 95 layers, many times what there is. The survey's
-    /// reservation holds the whole surface, and no hint reallocates it.
+    /// reservation holds the whole surface, and no hint reallocates it. The triangles' share of
+    /// it keeps a freed mesh with normals under glibc's trim threshold.
     #[test]
     fn a_surveyed_mesh_keeps_its_reservation() {
         let dims = [32, 32, 96];
@@ -229,7 +242,22 @@ mod tests {
             mesh.triangles.len()
         );
         assert_eq!(mesh.positions.capacity(), reserved);
-        assert_eq!(mesh.triangles.capacity(), 2 * reserved);
+        assert_eq!(mesh.triangles.capacity(), 2 * reserved + reserved / 2);
+        // With normals (and scikit-image's `f32` values, which the Python package allocates
+        // beside the mesh), everything freed stays under twice the triangle vector, glibc's
+        // threshold for giving the heap back (see `Mesh::triangle_room`).
+        let params = Params {
+            normals: true,
+            ..Params::new(0.0)
+        };
+        let mesh = extract(&Volume::new(&data, dims).unwrap(), &params).unwrap();
+        let bytes = |n: usize| 12 * n;
+        let (p, n, t) = (
+            bytes(mesh.positions.capacity()),
+            bytes(mesh.normals.capacity()),
+            bytes(mesh.triangles.capacity()),
+        );
+        assert!(p + n + t + p / 3 < 2 * t, "{p} + {n} + {t}");
     }
 
     /// A vector with 8 MiB of spare room, all of it written: after `release_spare` its elements

@@ -121,7 +121,7 @@ pub fn extract_par<T: Scalar>(
     } else {
         vec![0; room.len()]
     };
-    let triangle_room: Vec<usize> = room.iter().map(|&v| 2 * v).collect();
+    let triangle_room: Vec<usize> = room.iter().map(|&v| Mesh::triangle_room(v)).collect();
     let mut out = Mesh::default();
     let regions: Vec<Region<'_>> = region::stretches(&mut out.positions, &room)
         .into_iter()
