@@ -387,6 +387,7 @@ impl BlockMesh {
             normals: self.normals,
             triangles: self.triangles,
             stats: self.stats,
+            ..Mesh::default()
         })
     }
 }

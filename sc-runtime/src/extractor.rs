@@ -49,6 +49,7 @@ impl Extractor {
         let mesh = &mut self.mesh;
         mesh.positions.clear();
         mesh.normals.clear();
+        mesh.values.clear();
         mesh.triangles.clear();
         mesh.stats = Stats::default();
         if has_cubes(dims) {
@@ -57,7 +58,7 @@ impl Extractor {
                 nxy: dims[0] * dims[1],
             };
             let survey = Survey::new(&src, dims, T::threshold(params.iso));
-            mesh.reserve_for(survey.between(0, dims[2]), params.normals);
+            mesh.reserve_for(survey.between(0, dims[2]), params);
         }
         mesh.stats = extract_into(volume, params, self.scratch.lend(), &mut Presized(mesh))?;
         Ok(&self.mesh)

@@ -1,7 +1,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::{Error, Scratch, Sink, Stats};
+use crate::{Error, Params, Scratch, Sink, Stats};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -10,6 +10,9 @@ pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     /// Unit normals, one per position, or empty when normals were not asked for.
     pub normals: Vec<[f32; 3]>,
+    /// One value per position ([`Params::values`](crate::Params::values)), or empty when values
+    /// were not asked for.
+    pub values: Vec<f32>,
     /// Triangles wound so that `(b - a) × (c - a)` points from filled to empty.
     pub triangles: Vec<[u32; 3]>,
     /// Counts before and after merging.
@@ -21,15 +24,19 @@ impl Mesh {
     /// estimate), with a margin, so that the buffers are allocated once: untouched reserved pages
     /// cost address space, not memory. The margin, half as much again, covers estimates down to
     /// two thirds of the count, and the survey's are within 0.90–1.01 on the benchmark volumes.
-    pub(crate) fn reserve_for(&mut self, vertices: usize, normals: bool) {
+    pub(crate) fn reserve_for(&mut self, vertices: usize, params: &Params) {
         let v = Self::room_for(vertices);
         self.positions.reserve_exact(v);
-        if normals {
+        if params.normals {
             self.normals.reserve_exact(v);
+        }
+        if params.values {
+            self.values.reserve_exact(v);
         }
         self.triangles.reserve_exact(Self::triangle_room(v));
         huge_pages(&mut self.positions);
         huge_pages(&mut self.normals);
+        huge_pages(&mut self.values);
         huge_pages(&mut self.triangles);
     }
 
@@ -44,8 +51,8 @@ impl Mesh {
     /// Once glibc has unmapped a freed block, it keeps later blocks of that size on the heap
     /// and gives the heap's top back to the kernel when more than twice that size is free
     /// there. At two triangles per vertex the triangles are exactly as large as the positions
-    /// and the normals together, so freeing a mesh with normals (and scikit-image's values,
-    /// in the Python package) left just over twice the triangles free, and the next extraction
+    /// and the normals together, so freeing a mesh with normals (and values, as the Python
+    /// package's `marching_cubes` asks for) left just over twice the triangles free, and the next extraction
     /// faulted its pages in again: brainsmall in a loop 370 page faults per extraction, in
     /// Python 700 per call. Untouched room costs address space, not memory.
     pub(crate) fn triangle_room(vertices: usize) -> usize {
@@ -53,9 +60,9 @@ impl Mesh {
     }
 }
 
-/// [`Sink::vertex`] and [`Sink::triangle`] for a type with `positions`, `normals` and
-/// `triangles` fields that each have a `push`: the mesh's vectors, and a parallel chunk's
-/// stretches of them.
+/// [`Sink::vertex`], [`Sink::vertex_value`] and [`Sink::triangle`] for a type with
+/// `positions`, `normals`, `values` and `triangles` fields that each have a `push`: the mesh's
+/// vectors, and a parallel chunk's stretches of them.
 macro_rules! push_to_columns {
     () => {
         #[inline]
@@ -64,6 +71,11 @@ macro_rules! push_to_columns {
             if let Some(n) = normal {
                 self.normals.push(n);
             }
+        }
+
+        #[inline]
+        fn vertex_value(&mut self, value: f32) {
+            self.values.push(value);
         }
 
         #[inline]
@@ -90,6 +102,9 @@ impl Sink for Mesh {
         if !self.normals.is_empty() {
             grow(&mut self.normals, vertices);
         }
+        if !self.values.is_empty() {
+            grow(&mut self.values, vertices);
+        }
         grow(&mut self.triangles, triangles);
     }
 }
@@ -105,6 +120,11 @@ impl Sink for Presized<'_> {
     #[inline]
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
         self.0.vertex(position, normal);
+    }
+
+    #[inline]
+    fn vertex_value(&mut self, value: f32) {
+        self.0.vertex_value(value);
     }
 
     #[inline]

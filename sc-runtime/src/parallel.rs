@@ -20,6 +20,7 @@ const MIN_CHUNK_LAYERS: usize = 8;
 struct Region<'a> {
     positions: Stretch<'a, [f32; 3]>,
     normals: Stretch<'a, [f32; 3]>,
+    values: Stretch<'a, f32>,
     triangles: Stretch<'a, [u32; 3]>,
 }
 
@@ -32,6 +33,7 @@ impl Sink for Region<'_> {
 struct Part {
     positions: Filled<[f32; 3]>,
     normals: Filled<[f32; 3]>,
+    values: Filled<f32>,
     triangles: Filled<[u32; 3]>,
     vertices: usize,
     first_plane: u32,
@@ -116,20 +118,25 @@ pub fn extract_par<T: Scalar>(
         .iter()
         .map(|&(z0, z1)| Mesh::room_for(survey.between(z0, z1 + 1)))
         .collect();
-    let normal_room = if params.normals {
-        room.clone()
-    } else {
-        vec![0; room.len()]
+    let room_if = |asked: bool| {
+        if asked {
+            room.clone()
+        } else {
+            vec![0; room.len()]
+        }
     };
+    let (normal_room, value_room) = (room_if(params.normals), room_if(params.values));
     let triangle_room: Vec<usize> = room.iter().map(|&v| Mesh::triangle_room(v)).collect();
     let mut out = Mesh::default();
     let regions: Vec<Region<'_>> = region::stretches(&mut out.positions, &room)
         .into_iter()
         .zip(region::stretches(&mut out.normals, &normal_room))
+        .zip(region::stretches(&mut out.values, &value_room))
         .zip(region::stretches(&mut out.triangles, &triangle_room))
-        .map(|((positions, normals), triangles)| Region {
+        .map(|(((positions, normals), values), triangles)| Region {
             positions,
             normals,
+            values,
             triangles,
         })
         .collect();
@@ -156,6 +163,7 @@ pub fn extract_par<T: Scalar>(
                     vertices: region.positions.len(),
                     positions: region.positions.finish(),
                     normals: region.normals.finish(),
+                    values: region.values.finish(),
                     triangles: region.triangles.finish(),
                     first_plane,
                     stats: sweep.stats(),
@@ -212,12 +220,14 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
     out.stats = parts.iter().fold(Stats::default(), |s, p| s + p.stats);
     let mut emitted = 0u32;
     let mut shifts = Vec::with_capacity(parts.len());
-    let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut positions, mut normals, mut values, mut triangles) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for p in parts {
         shifts.push(emitted - p.first_plane);
         emitted += p.vertices as u32;
         positions.push(p.positions);
         normals.push(p.normals);
+        values.push(p.values);
         triangles.push(p.triangles);
     }
     // SAFETY: each list is the finished stretches of that vector, all of them, in order (one
@@ -225,6 +235,7 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
     unsafe {
         region::join(&mut out.positions, &positions, |_, _| {});
         region::join(&mut out.normals, &normals, |_, _| {});
+        region::join(&mut out.values, &values, |_, _| {});
         region::join(&mut out.triangles, &triangles, |i, t| {
             t.as_flattened_mut()
                 .iter_mut()
@@ -233,6 +244,7 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
     }
     release_spare(&mut out.positions);
     release_spare(&mut out.normals);
+    release_spare(&mut out.values);
     release_spare(&mut out.triangles);
     Ok(())
 }

@@ -32,6 +32,13 @@ pub struct Params {
     pub mode: Mode,
     /// Emit per-vertex normals (negated, normalised central-difference gradients).
     pub normals: bool,
+    /// Emit per vertex the larger of the two samples at the ends of its grid edge, as `f32` (a
+    /// NaN end gives NaN), through [`Sink::vertex_value`](crate::Sink::vertex_value): what
+    /// scikit-image's `marching_cubes` returns as `values`. The sweep has both samples at hand
+    /// when it places the vertex; looked up afterwards from the positions, they had left the
+    /// cache, and the pass took a tenth of the Python call. Off by default; block extraction
+    /// (`extract_block`) does not carry values.
+    pub values: bool,
     /// World distance between samples along x, y, z.
     pub spacing: [f64; 3],
     /// World position of sample `(0, 0, 0)`.
@@ -44,12 +51,13 @@ pub struct Params {
 }
 
 impl Params {
-    /// Embedded mode, with normals, unit spacing and the origin at zero.
+    /// Embedded mode, with normals, without values, unit spacing and the origin at zero.
     pub fn new(iso: f64) -> Self {
         Params {
             iso,
             mode: Mode::Embedded,
             normals: true,
+            values: false,
             spacing: [1.0; 3],
             origin: [0.0; 3],
             max_error: None,

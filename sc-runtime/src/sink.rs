@@ -20,6 +20,13 @@ pub trait Sink {
         let _ = (lower, axis);
         self.vertex(position, normal);
     }
+    /// The value of the vertex just sent, when [`Params::values`](crate::Params::values) asks
+    /// for values: the larger of the two samples at the ends of its edge. The default ignores
+    /// it.
+    #[inline]
+    fn vertex_value(&mut self, value: f32) {
+        let _ = value;
+    }
     /// [`Sink::triangle`], told which cube emits it (its lower corner, in the whole grid's
     /// indices); a merged pair's triangle belongs to the lower cube of the pair.
     #[inline]

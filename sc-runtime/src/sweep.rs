@@ -478,6 +478,11 @@ impl Out<'_> {
                 None
             };
             sink.edge_vertex(global, AXIS, pos, normal);
+            if params.values {
+                let (a, b) = (a.to_f64(), b.to_f64());
+                // As NumPy's `maximum`: a NaN end gives NaN.
+                sink.vertex_value((if a > b || a.is_nan() { a } else { b }) as f32);
+            }
         }
         Ok(id)
     }

@@ -9,26 +9,43 @@ use sc_runtime::{
 };
 use sc_tests::volumes::{self, Sample, Vol, brainsmall_crop, integer_noise, stent_crop};
 
-/// A mesh as bits: positions, normals, triangles, stats.
-type Bits<'a> = (Vec<[u32; 3]>, Vec<[u32; 3]>, &'a [[u32; 3]], Stats);
+/// A mesh as bits: positions, normals, values, triangles, stats.
+type Bits<'a> = (
+    Vec<[u32; 3]>,
+    Vec<[u32; 3]>,
+    Vec<u32>,
+    &'a [[u32; 3]],
+    Stats,
+);
 
 /// Meshes compared as bits, so even a NaN or a signed zero would count.
 fn bits(m: &Mesh) -> Bits<'_> {
     let f = |v: &[[f32; 3]]| v.iter().map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
-    (f(&m.positions), f(&m.normals), &m.triangles, m.stats)
+    let values = m.values.iter().map(|v| v.to_bits()).collect();
+    (
+        f(&m.positions),
+        f(&m.normals),
+        values,
+        &m.triangles,
+        m.stats,
+    )
 }
 
 fn all_entry_points_agree<T: Sample>(vol: &Vol<T>, what: &str) {
     for mode in [Mode::Steps123, Mode::Embedded, Mode::Paper] {
+        // Normals and values together or neither: each column on its own is the same code.
         for normals in [true, false] {
             let params = Params {
                 normals,
+                values: normals,
                 ..vol.params(mode)
             };
             let v = Volume::new(&vol.data, vol.dims).expect("valid");
             let base = extract(&v, &params).expect("extract");
             assert!(!base.triangles.is_empty(), "{what}: empty");
             assert_eq!(base.normals.is_empty(), !normals);
+            let columns = if normals { base.positions.len() } else { 0 };
+            assert_eq!((base.normals.len(), base.values.len()), (columns, columns));
             for threads in [1, 2, 8] {
                 let done = std::sync::atomic::AtomicUsize::new(0);
                 let par = extract_par(&v, &params, threads, &|n| {
@@ -90,6 +107,77 @@ fn thread_count_streaming_and_scratch_do_not_change_the_mesh() {
     // Fewer layers than threads, and a single layer.
     all_entry_points_agree(&integer_noise([9, 9, 3], 3, 2), "3 slices");
     all_entry_points_agree(&integer_noise([9, 9, 2], 3, 3), "2 slices");
+}
+
+/// Records each vertex's grid edge and value, as the sweep hands them over.
+#[derive(Default)]
+struct EdgeValues {
+    edges: Vec<([usize; 3], usize)>,
+    values: Vec<f32>,
+}
+
+impl sc_runtime::Sink for EdgeValues {
+    fn vertex(&mut self, _: [f32; 3], _: Option<[f32; 3]>) {
+        unreachable!("the sweep names every vertex's edge")
+    }
+    fn edge_vertex(&mut self, lower: [usize; 3], axis: usize, _: [f32; 3], _: Option<[f32; 3]>) {
+        self.edges.push((lower, axis));
+    }
+    fn vertex_value(&mut self, value: f32) {
+        assert_eq!(
+            self.values.len() + 1,
+            self.edges.len(),
+            "one value per vertex"
+        );
+        self.values.push(value);
+    }
+    fn triangle(&mut self, _: [u32; 3]) {}
+}
+
+/// `Params::values`: each vertex's value is the larger of the samples at its edge's ends, and
+/// NaN where either end is NaN (as NumPy's `maximum`), in every mode, for integer ties and for
+/// floats with NaN holes.
+#[test]
+fn values_are_the_larger_sample_of_each_vertex_edge() {
+    fn check<T: Sample>(vol: &Vol<T>, what: &str) {
+        let at = |p: [usize; 3]| vol.data[p[0] + vol.dims[0] * (p[1] + vol.dims[1] * p[2])];
+        for mode in [Mode::Steps123, Mode::Embedded, Mode::Paper] {
+            let params = Params {
+                values: true,
+                ..vol.params(mode)
+            };
+            let v = Volume::new(&vol.data, vol.dims).expect("valid");
+            let len = Scratch::len(vol.dims).expect("len");
+            let (mut b, mut w) = (vec![0u8; len.bytes], vec![0u32; len.words]);
+            let scratch = Scratch::new(&mut b, &mut w, vol.dims).expect("scratch");
+            let mut sink = EdgeValues::default();
+            extract_into(&v, &params, scratch, &mut sink).expect("extract_into");
+            assert!(!sink.edges.is_empty(), "{what}: empty");
+            assert_eq!(sink.values.len(), sink.edges.len(), "{what} {mode:?}");
+            for (&(lower, axis), &value) in sink.edges.iter().zip(&sink.values) {
+                let mut upper = lower;
+                upper[axis] += 1;
+                let (a, b) = (at(lower).as_f64(), at(upper).as_f64());
+                let want = if a.is_nan() || b.is_nan() {
+                    f64::NAN
+                } else {
+                    a.max(b)
+                };
+                assert_eq!(
+                    value.to_bits(),
+                    (want as f32).to_bits(),
+                    "{what} {mode:?}: edge {lower:?} along {axis}"
+                );
+            }
+        }
+    }
+    check(&integer_noise([20, 17, 33], 3, 1), "integer ties");
+    check(&stent_crop(250.0), "stent crop");
+    let mut holes = volumes::demo(demo::sphere_noise(24));
+    for i in (0..holes.data.len()).step_by(97) {
+        holes.data[i] = f64::NAN;
+    }
+    check(&holes, "sphere with NaN holes");
 }
 
 #[test]
