@@ -110,6 +110,7 @@ pub(crate) mod test_mesh {
             normals,
             triangles,
             stats,
+            ..Mesh::default()
         }
     }
 }
