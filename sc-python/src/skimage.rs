@@ -1,6 +1,8 @@
 //! scikit-image's layout of a mesh, made in Rust: `marching_cubes` returns vertices and normals
-//! in the array's axis order, `int32` faces wound its way, and a value per vertex. Done in NumPy
-//! these were five temporary arrays and half the extraction's time again on small scans.
+//! in the array's axis order, faces wound its way, and a value per vertex. Done in NumPy these
+//! were five temporary arrays and half the extraction's time again on small scans. Each pass left
+//! here is one the layout needs: the axes reversed for a C-ordered array, the winding turned for
+//! one of the two gradient directions.
 
 use numpy::{PyArray1, PyUntypedArray};
 use pyo3::prelude::*;
@@ -11,8 +13,9 @@ use crate::extract::{mode, run};
 
 /// Extracts the surface (embedded mode, with normals and values) and returns
 /// `(verts, faces, normals, values)`: with `reverse_axes`, coordinates as `(z, y, x)`; with
-/// `flip_winding`, each face's vertex order reversed; `values` the larger sample at the two ends
-/// of each vertex's grid edge, which the sweep records as it places the vertex.
+/// `flip_winding`, each face's vertex order reversed; faces as `uint32`; `values` the larger
+/// sample at the two ends of each vertex's grid edge, which the sweep records as it places the
+/// vertex.
 #[pyfunction]
 #[pyo3(signature = (volume, level, spacing, threads, reverse_axes, flip_winding))]
 #[allow(clippy::type_complexity)]
@@ -39,30 +42,24 @@ pub fn skimage_mesh<'py>(
         mut positions,
         mut normals,
         values,
-        triangles,
+        mut triangles,
         ..
     } = mesh;
-    let faces: Vec<[i32; 3]> = py.detach(|| {
+    py.detach(|| {
         if reverse_axes {
             positions.iter_mut().for_each(|p| p.reverse());
             normals.iter_mut().for_each(|n| n.reverse());
         }
-        // Fewer than 2^31 vertices: the runtime numbers them in u32, and a mesh that large
-        // would not fit in memory as f32 triples anyway.
-        // Same size and alignment: the standard library collects this in place.
-        let face = |t: [u32; 3]| t.map(|i| i as i32);
         if flip_winding {
-            triangles
-                .into_iter()
-                .map(|[a, b, c]| face([c, b, a]))
-                .collect()
-        } else {
-            triangles.into_iter().map(face).collect()
+            triangles.iter_mut().for_each(|t| t.swap(0, 2));
         }
     });
+    // The faces go out as `uint32`; the caller views them as `int32` (no copy), which holds
+    // every index: the runtime numbers vertices in `u32`, and a mesh of 2^31 vertices would
+    // not fit in memory as `f32` triples.
     (
         convert::rows(py, positions)?,
-        convert::rows(py, faces)?,
+        convert::rows(py, triangles)?,
         convert::rows(py, normals)?,
         PyArray1::from_vec(py, values),
     )

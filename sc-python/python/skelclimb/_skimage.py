@@ -122,6 +122,7 @@ def marching_cubes(
     verts, faces, normals, values = _native.skimage_mesh(
         volume, level, xyz_spacing, int(threads), c_order, flip
     )
+    faces = faces.view(np.int32)  # uint32 indices below 2**31: the same bits, no copy
     if len(faces) == 0:
         # Only an empty surface can come from a level outside the data's range (a triangle needs
         # a sample below the level and one at or above it), so the range is read only then: two
