@@ -4,7 +4,7 @@
 //! [`remove_pending`].
 
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -108,7 +108,7 @@ impl AtomicFile {
     /// Writes the content with `fill` through a buffer, then renames the file over the target.
     pub fn write_with(
         self,
-        fill: impl FnOnce(&mut BufWriter<&File>) -> io::Result<()>,
+        fill: impl FnOnce(&mut BufWriter<Output<'_>>) -> io::Result<()>,
     ) -> Result<()> {
         self.fill(fill)?.commit()
     }
@@ -118,19 +118,91 @@ impl AtomicFile {
     /// so a full disk leaves none of them half-updated.
     pub fn fill(
         self,
-        fill: impl FnOnce(&mut BufWriter<&File>) -> io::Result<()>,
+        fill: impl FnOnce(&mut BufWriter<Output<'_>>) -> io::Result<()>,
     ) -> Result<Filled> {
         let fail =
             |e: io::Error| Error::file(&self.target, format!("cannot write: {}", io_reason(&e)));
         // 64 KiB: enough to batch the text formats' small writes. The binary writers hand over
         // larger batches, which pass straight through; a 1 MiB buffer only added 256 pages to
         // fault in (0.5 ms of a small scan's 15 ms run).
-        let mut out = BufWriter::with_capacity(1 << 16, self.temp.as_file());
+        let mut out = BufWriter::with_capacity(1 << 16, Output::new(self.temp.as_file()));
         fill(&mut out).map_err(fail)?;
         out.flush().map_err(fail)?;
         drop(out);
         self.temp.as_file().sync_all().map_err(fail)?;
         Ok(Filled(self))
+    }
+}
+
+/// The temporary file as [`AtomicFile::fill`] writes it. On Linux, each mebibyte written is handed
+/// to the disk at once (`sync_file_range`), so that the `fsync` before the rename waits only for
+/// the last of it: on a 4.8 MB PLY that `fsync` took 3–4 ms, most of the run's fixed cost.
+pub struct Output<'a> {
+    file: &'a File,
+    /// Where the next write lands.
+    at: u64,
+    /// The end of the data written so far, and how far of it has been handed to the disk.
+    end: u64,
+    started: u64,
+}
+
+/// Bytes written between two starts of writeback.
+#[cfg(target_os = "linux")]
+const WRITEBACK_EVERY: u64 = 1 << 20;
+
+impl<'a> Output<'a> {
+    fn new(file: &'a File) -> Self {
+        Output {
+            file,
+            at: 0,
+            end: 0,
+            started: 0,
+        }
+    }
+
+    /// Starts writing to disk what was written since the last start, without waiting for it.
+    #[cfg(target_os = "linux")]
+    fn start_writeback(&mut self) {
+        use std::os::fd::AsRawFd;
+        if self.end - self.started >= WRITEBACK_EVERY {
+            let (from, len) = (self.started, self.end - self.started);
+            // SAFETY: sync_file_range only reads the file descriptor, which `file` keeps open.
+            // Its result is a hint's: where it fails, the fsync does all the work, as before.
+            unsafe {
+                libc::sync_file_range(
+                    self.file.as_raw_fd(),
+                    from as libc::off64_t,
+                    len as libc::off64_t,
+                    libc::SYNC_FILE_RANGE_WRITE,
+                )
+            };
+            self.started = self.end;
+        }
+    }
+
+    #[cfg(not(target_os = "linux"))]
+    fn start_writeback(&mut self) {}
+}
+
+impl Write for Output<'_> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.at += n as u64;
+        self.end = self.end.max(self.at);
+        self.start_writeback();
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.flush()
+    }
+}
+
+/// The NumPy `.npz` writer goes back to fill in sizes.
+impl Seek for Output<'_> {
+    fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+        self.at = self.file.seek(pos)?;
+        Ok(self.at)
     }
 }
 
@@ -211,6 +283,39 @@ mod tests {
         assert!(err.to_string().contains("disk full"), "{err}");
         assert_eq!(std::fs::read(&target).unwrap(), b"old");
         assert_eq!(entries(dir.path()), ["a.ply"]);
+    }
+
+    /// Several mebibytes in uneven pieces, past the points where writeback starts, then a seek
+    /// back to patch the start (as the `.npz` writer does): the file holds exactly what was
+    /// written, and the writeback started for every whole mebibyte but the last.
+    #[test]
+    fn writeback_and_seeks_keep_the_bytes() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("big.bin");
+        let want: Vec<u8> = (0..(3 << 20) + 12_345u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
+            .collect();
+        let mut started = 0;
+        AtomicFile::create(&target)
+            .unwrap()
+            .write_with(|w| {
+                w.write_all(&[0; 8])?;
+                for piece in want[8..].chunks(70_001) {
+                    w.write_all(piece)?;
+                }
+                w.seek(SeekFrom::Start(0))?;
+                w.write_all(&want[..8])?;
+                w.flush()?;
+                started = w.get_ref().started;
+                Ok(())
+            })
+            .unwrap();
+        assert!(std::fs::read(&target).unwrap() == want);
+        #[cfg(target_os = "linux")]
+        assert!(
+            started >= 2 << 20 && started <= want.len() as u64,
+            "{started}"
+        );
     }
 
     #[test]
