@@ -35,13 +35,18 @@ fn header(
 pub fn write_binary(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
     header(mesh, "binary_little_endian", options, out)?;
     let with_normals = !mesh.normals.is_empty();
-    let vertex_bytes = if with_normals { 24 } else { 12 };
-    in_chunks(mesh.positions.len(), vertex_bytes, out, |i, rec| {
-        put_floats(&mut rec[..12], &mesh.positions[i]);
-        if with_normals {
-            put_floats(&mut rec[12..], &mesh.normals[i]);
-        }
-    })?;
+    if !with_normals && cfg!(target_endian = "little") {
+        // Positions alone are already the file's records, byte for byte.
+        out.write_all(bytemuck::cast_slice(&mesh.positions))?;
+    } else {
+        let vertex_bytes = if with_normals { 24 } else { 12 };
+        in_chunks(mesh.positions.len(), vertex_bytes, out, |i, rec| {
+            put_floats(&mut rec[..12], &mesh.positions[i]);
+            if with_normals {
+                put_floats(&mut rec[12..], &mesh.normals[i]);
+            }
+        })?;
+    }
     in_chunks(mesh.triangles.len(), 13, out, |i, rec| {
         rec[0] = 3;
         for (field, v) in rec[1..].chunks_exact_mut(4).zip(mesh.triangles[i]) {
@@ -127,16 +132,23 @@ mod tests {
         mesh
     }
 
+    /// With normals (records encoded field by field) and without (positions written as they
+    /// lie in memory).
     #[test]
     fn binary_round_trips() {
-        let mesh = tetrahedron();
-        let mut bytes = Vec::new();
-        write_binary(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
-        let back = read_back(&bytes);
-        assert_eq!(
-            (back.positions, back.normals, back.triangles),
-            (mesh.positions, mesh.normals, mesh.triangles)
-        );
+        for normals in [true, false] {
+            let mut mesh = tetrahedron();
+            if !normals {
+                mesh.normals.clear();
+            }
+            let mut bytes = Vec::new();
+            write_binary(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
+            let back = read_back(&bytes);
+            assert_eq!(
+                (back.positions, back.normals, back.triangles),
+                (mesh.positions, mesh.normals, mesh.triangles)
+            );
+        }
     }
 
     #[test]
