@@ -51,10 +51,10 @@ impl Mesh {
     /// Once glibc has unmapped a freed block, it keeps later blocks of that size on the heap
     /// and gives the heap's top back to the kernel when more than twice that size is free
     /// there. At two triangles per vertex the triangles are exactly as large as the positions
-    /// and the normals together, so freeing a mesh with normals (and values, as the Python
-    /// package's `marching_cubes` asks for) left just over twice the triangles free, and the next extraction
-    /// faulted its pages in again: brainsmall in a loop 370 page faults per extraction, in
-    /// Python 700 per call. Untouched room costs address space, not memory.
+    /// and the normals together, so freeing a mesh with normals (and values, which the Python
+    /// package's `marching_cubes` asks for) left just over twice the triangles free, and the
+    /// next extraction faulted its pages in again: brainsmall in a loop 370 page faults per
+    /// extraction, in Python 700 per call. Untouched room costs address space, not memory.
     pub(crate) fn triangle_room(vertices: usize) -> usize {
         2 * vertices + vertices / 2
     }
@@ -263,14 +263,17 @@ mod tests {
         );
         assert_eq!(mesh.positions.capacity(), reserved);
         assert_eq!(mesh.triangles.capacity(), 2 * reserved + reserved / 2);
-        // With normals (and scikit-image's `f32` values, which the Python package allocates
-        // beside the mesh), everything freed stays under twice the triangle vector, glibc's
-        // threshold for giving the heap back (see `Mesh::triangle_room`).
+        // With normals and values (`f32`, a third of a position: the `p / 3` below), as the
+        // Python package's `marching_cubes` asks for them, everything freed stays under twice
+        // the triangle vector, glibc's threshold for giving the heap back (see
+        // `Mesh::triangle_room`).
         let params = Params {
             normals: true,
+            values: true,
             ..Params::new(0.0)
         };
         let mesh = extract(&Volume::new(&data, dims).unwrap(), &params).unwrap();
+        assert_eq!(mesh.values.capacity(), mesh.positions.capacity());
         let bytes = |n: usize| 12 * n;
         let (p, n, t) = (
             bytes(mesh.positions.capacity()),
