@@ -178,8 +178,11 @@ impl<T: Scalar> Field<'_, T> {
         // The test reads the squared length, not its root: a branch on the root would wait for
         // the square root's long latency, and that wait was a quarter of what normals cost.
         let squared = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        // Positive and finite; NaN fails both tests.
-        if squared > 0.0 && squared < f64::INFINITY {
+        // Positive and finite (NaN fails), tested on the bits: positive finite doubles are the
+        // bit patterns 1 ..= f64::MAX's, and one unsigned compare finds them. Written as two
+        // float compares, the test compiled to a classification of the bits in 18 instructions
+        // per vertex.
+        if squared.to_bits().wrapping_sub(1) < f64::MAX.to_bits() {
             let inv = 1.0 / sqrt(squared);
             g.map(|c| (c * inv) as f32)
         } else {
