@@ -249,9 +249,19 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let ybase = xbase + nx * ny;
         let [px, py, pz] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
+            let (lo, hi) = grid.span(grid.slice_row(n, y));
+            let (start, end) = if y + 1 < ny {
+                grid.union_span([(y, n), (y + 1, n)])
+            } else {
+                (0, 0)
+            };
+            // Rows wholly inside or outside the surface, with their neighbour, are skipped before
+            // anything is sliced: slicing the rows cost more than scanning them.
+            if lo >= hi && start >= end {
+                continue;
+            }
             let row = grid.padded_row(n, y);
             let values = &samples[y * nx..][..nx];
-            let (lo, hi) = grid.span(grid.slice_row(n, y));
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
             let ids = xbase + y * nx;
             for_each_differing(row, &row[1..], lo, hi, |x| {
@@ -264,7 +274,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             if y + 1 < ny {
                 let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
-                let (start, end) = grid.union_span([(y, n), (y + 1, n)]);
                 let ids = ybase + y * nx;
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
@@ -295,9 +304,13 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
         for y in 0..ny {
+            let (start, end) = grid.union_span([(y, k), (y, k + 1)]);
+            // As in `plane_vertices`: nothing is sliced for a row with nothing to scan.
+            if start >= end {
+                continue;
+            }
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
-            let (start, end) = grid.union_span([(y, k), (y, k + 1)]);
             let ids = zbase + y * nx;
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
