@@ -248,10 +248,13 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
         region::join(&mut out.positions, &positions, |_, _| {});
         region::join(&mut out.normals, &normals, |_, _| {});
         region::join(&mut out.values, &values, |_, _| {});
+        // The first part's shift is zero: it stays where it is, untouched.
         region::join(&mut out.triangles, &triangles, |i, t| {
-            t.as_flattened_mut()
-                .iter_mut()
-                .for_each(|v| *v += shifts[i]);
+            if shifts[i] != 0 {
+                t.as_flattened_mut()
+                    .iter_mut()
+                    .for_each(|v| *v += shifts[i]);
+            }
         });
     }
     release_spare(&mut out.positions);

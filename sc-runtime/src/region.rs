@@ -11,8 +11,6 @@
 use alloc::vec::Vec;
 use core::mem::MaybeUninit;
 
-use rayon::prelude::*;
-
 #[cfg(doc)]
 use crate::Mesh;
 use crate::mesh::huge_pages;
@@ -83,16 +81,20 @@ pub(crate) fn stretches<'a, T>(buf: &'a mut Vec<T>, lens: &[usize]) -> Vec<Stret
         .collect()
 }
 
-/// Makes `buf` the concatenation of `parts` in order, each part first passed to `adjust` with
-/// its index.
+/// Elements moved and adjusted at a time by [`join`]: 24 KiB of triangles, within a core's L1
+/// data cache.
+const BLOCK: usize = 2048;
+
+/// Makes `buf` the concatenation of `parts` in order, each part's elements passed to `adjust`
+/// with the part's index (in pieces, where they land).
 ///
 /// # Safety
 /// `parts` are the finished stretches of [`stretches`] on this `buf`, all of them, in order, and
 /// `buf` has not been touched since.
-pub(crate) unsafe fn join<T: Copy + Send>(
+pub(crate) unsafe fn join<T: Copy>(
     buf: &mut Vec<T>,
     parts: &[Filled<T>],
-    adjust: impl Fn(usize, &mut [T]) + Sync,
+    adjust: impl Fn(usize, &mut [T]),
 ) {
     let total: usize = parts.iter().map(|p| p.len + p.spill.len()).sum();
     if parts.iter().any(|p| !p.spill.is_empty()) {
@@ -110,21 +112,26 @@ pub(crate) unsafe fn join<T: Copy + Send>(
         return;
     }
     let base = buf.as_mut_ptr();
-    // SAFETY: each part's first `len` elements were written, and the stretches are disjoint.
-    let written: Vec<&mut [T]> = parts
-        .iter()
-        .map(|p| unsafe { core::slice::from_raw_parts_mut(base.add(p.start), p.len) })
-        .collect();
-    written
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(i, part)| adjust(i, part));
     let mut to = 0;
-    for p in parts {
-        // SAFETY: stretches start at the sum of the room before them, at or past the sum of
-        // the lengths before them (`to`): both ranges lie within the capacity, and `copy` is
-        // `memmove`, which allows them to overlap.
-        unsafe { core::ptr::copy(base.add(p.start), base.add(to), p.len) };
+    for (i, p) in parts.iter().enumerate() {
+        // A block at a time, each adjusted where it lands while it is in the cache: moving the
+        // parts and then adjusting them went through the memory twice.
+        for at in (0..p.len).step_by(BLOCK) {
+            let n = BLOCK.min(p.len - at);
+            // SAFETY: stretches start at the sum of the room before them, at or past the sum of
+            // the lengths before them (`to`): both ranges lie within the capacity, and `copy`
+            // is `memmove`, which allows them to overlap. Blocks go in ascending order and land
+            // at or below where they were read, so no block overwrites one not yet moved. The
+            // part's first `len` elements were written (the caller's contract), so the landed
+            // block is initialised.
+            let block = unsafe {
+                if p.start != to {
+                    core::ptr::copy(base.add(p.start + at), base.add(to + at), n);
+                }
+                core::slice::from_raw_parts_mut(base.add(to + at), n)
+            };
+            adjust(i, block);
+        }
         to += p.len;
     }
     // SAFETY: the first `total` elements are now the parts' elements, all initialised.
@@ -137,25 +144,29 @@ mod tests {
     use alloc::vec::Vec;
 
     /// Parts that fit their stretches, and parts that overflow them (one of them a stretch of
-    /// none): the vector is their concatenation, each mapped by its index.
+    /// none), and parts of several blocks moved a little or a long way down (over themselves):
+    /// the vector is their concatenation, each mapped by its index.
     #[test]
     fn joined_parts_are_concatenated_in_order() {
+        let b = super::BLOCK;
         for (lens, counts) in [
-            ([3, 0, 5], [3, 0, 2]),
+            ([3, 0, 5], [3usize, 0, 2]),
             ([3, 4, 5], [1, 4, 0]),
             ([3, 0, 5], [3, 2, 5]),
             ([2, 2, 2], [4, 0, 3]),
+            ([2 * b + 9, 3 * b, b + 1], [2 * b + 8, 3 * b - 7, b + 1]),
+            ([3 * b, 5, 2 * b + 3], [7, 5, 2 * b + 3]),
         ] {
             let mut buf: Vec<u32> = Vec::new();
             let mut want = Vec::new();
             let mut parts = stretches(&mut buf, &lens);
             for (i, (part, &n)) in parts.iter_mut().zip(&counts).enumerate() {
                 for k in 0..n {
-                    let x = 100 * i as u32 + k;
+                    let x = (i as u32) << 24 | k as u32;
                     part.push(x);
                     want.push(x + i as u32);
                 }
-                assert_eq!(part.len(), n as usize);
+                assert_eq!(part.len(), n);
             }
             let filled: Vec<_> = parts.into_iter().map(|p| p.finish()).collect();
             // SAFETY: all the stretches of `buf`, finished, in order.
