@@ -13,6 +13,8 @@
 
 use core::num::NonZeroU8;
 
+use wide::u8x16;
+
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::Entry;
 use crate::vertex::{Field, sample_crossing};
@@ -619,13 +621,13 @@ impl Grid<'_> {
                 continue;
             }
             // The rows run past `hi` into the next row or the padding (see `cube_cases`).
-            let chunks = (hi - lo).div_ceil(8);
+            let blocks = (hi - lo).div_ceil(16);
             let filled = &*self.filled;
             let row = |n: usize| {
                 let (y, z) = rows[n];
-                &filled[(z % 4) * nx * ny + y * nx + lo..][..8 * chunks + 1]
+                &filled[(z % 4) * nx * ny + y * nx + lo..][..16 * blocks + 1]
             };
-            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..8 * chunks];
+            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..16 * blocks];
             cube_cases([row(0), row(1), row(2), row(3)], out, hi - lo);
         }
     }
@@ -784,76 +786,82 @@ impl Grid<'_> {
 }
 
 /// Calls `f(x, case)` for each `x` in `start..end`, in order, whose cube the surface crosses (its
-/// case is neither 0 nor 255). Tests eight cases at a time: most of a row's span lies wholly inside
-/// or outside the surface (seven in eight cubes of brainsmall's spans), and the crossed cubes of a
-/// word are then taken from its mask, each case from the word itself, so that a crossed cube costs
-/// no second load of its word. `cases` runs at least seven bytes past `end` (see [`within`]).
+/// case is neither 0 nor 255). Tests sixteen cases at a time: most of a row's span lies wholly
+/// inside or outside the surface (seven in eight cubes of brainsmall's spans), and the crossed
+/// cubes of a block are then taken from its mask, each case from the block itself, so that a
+/// crossed cube costs no second load. `cases` runs at least fifteen bytes past `end` (see
+/// [`lanes`]).
 #[inline(always)]
 fn for_each_crossed(cases: &[u8], start: usize, end: usize, mut f: impl FnMut(usize, u8)) {
-    const LOW_BITS: u64 = 0x0101_0101_0101_0101;
     let mut x = start;
     while x < end {
-        let word = u64::from_le_bytes(cases[x..x + 8].try_into().expect("eight bytes"));
-        // A byte is 0 or 255 exactly when it equals its low bit times 255: the others are
-        // the non-zero bytes of `crossed`.
-        let mut crossed = word ^ ((word & LOW_BITS) * 0xFF);
-        if end - x < 8 {
-            crossed &= within(end - x);
-        }
+        let block: [u8; LANES] = cases[x..x + LANES].try_into().expect("sixteen bytes");
+        let v = u8x16::new(block);
+        let trivial = v.simd_eq(u8x16::splat(0)) | v.simd_eq(u8x16::splat(255));
+        let mut crossed = !trivial.to_bitmask() & lanes(end - x);
         while crossed != 0 {
-            let shift = crossed.trailing_zeros() & !7;
-            f(x + shift as usize / 8, (word >> shift) as u8);
-            crossed &= !(0xFF << shift);
+            let n = crossed.trailing_zeros() as usize;
+            f(x + n, block[n % LANES]);
+            crossed &= crossed - 1;
         }
-        x += 8;
+        x += LANES;
     }
 }
 
-/// The mask of an eight-byte word's first `left` bytes, `left` from 1 to 8.
-/// Rows are read a whole word at a time, past their end into padding or the next row, and the
-/// mask keeps what lies within: a byte-by-byte loop over the last few bytes of each row cost
-/// about 2 % of brainsmall's instructions.
+/// Bytes per block of the row scans: one SSE2 or NEON register, whose compare gives a bit mask
+/// of the block (`to_bitmask`), so that a scan walks the mask's bits straight to the bytes it
+/// wants. Eight-byte words, which needed a shift and a mask per byte found, took 7–10 % more
+/// instructions over the whole sweep.
+const LANES: usize = 16;
+
+/// The bit mask of a block's first `left` bytes (all of them from 16 up). Rows are read a whole
+/// block at a time, past their end into padding or the next row, and the mask keeps what lies
+/// within: a byte-by-byte loop over the last few bytes of each row cost about 2 % of brainsmall's
+/// instructions.
 #[inline(always)]
-fn within(left: usize) -> u64 {
-    u64::MAX >> (8 * (8 - left))
+fn lanes(left: usize) -> u32 {
+    u32::MAX >> (32 - LANES.min(left))
 }
 
-/// The cases of cubes `0..len` into `out` (`8 · ⌈len / 8⌉` bytes; those from `len` on are left
+/// Sixteen bytes from the start of `bytes`.
+#[inline(always)]
+fn load(bytes: &[u8]) -> u8x16 {
+    u8x16::new(bytes[..LANES].try_into().expect("sixteen bytes"))
+}
+
+/// The cases of cubes `0..len` into `out` (`16 · ⌈len / 16⌉` bytes; those from `len` on are left
 /// as they were), from their four sample rows — `y` and `y + 1` at `z`, then at `z + 1` — each at
 /// least one byte longer than `out`.
 ///
-/// Eight cubes at a time, from each row's words at `x` and `x + 1`: the samples are 0 or 1, so no
-/// bit crosses into the next byte. Zips over each row vectorised, but every row paid a scalar tail
-/// and its loop's exit mispredicted (a tenth of brainsmall's simulated mispredictions).
+/// A block of cubes at a time, from each row's blocks at `x` and `x + 1`. Zips over each row
+/// vectorised, but every row paid a scalar tail and its loop's exit mispredicted (a tenth of
+/// brainsmall's simulated mispredictions).
 #[inline(always)]
 fn cube_cases(rows: [&[u8]; 4], out: &mut [u8], len: usize) {
-    let chunks = out.len() / 8;
-    for (c, cell) in out.chunks_exact_mut(8).enumerate() {
-        let mut case = 0;
-        for (n, row) in rows.iter().enumerate() {
-            case |= pairs(&row[8 * c..8 * c + 9]) << (2 * n);
-        }
-        if c + 1 == chunks {
+    let blocks = out.len() / LANES;
+    for (c, cell) in out.chunks_exact_mut(LANES).enumerate() {
+        // Bit `2n` of a case is row `n` at `x`, bit `2n + 1` the same row at `x + 1`: built
+        // from the last bit down by doubling, which needs no masks (samples are 0 or 1).
+        let case = rows.iter().rev().fold(u8x16::splat(0), |case, row| {
+            let at = |o: usize| load(&row[LANES * c + o..]);
+            let case = case + case + at(1);
+            case + case + at(0)
+        });
+        if c + 1 == blocks {
             // Past the span: leave the next cubes' cases as they are.
-            let keep = !within(len - 8 * c);
-            let old = u64::from_le_bytes(cell.try_into().expect("eight bytes"));
-            case = case & !keep | old & keep;
+            let keep = !(u128::MAX >> (8 * (LANES - (len - LANES * c))));
+            let old = u128::from_le_bytes(cell.try_into().expect("sixteen bytes"));
+            let case = u128::from_le_bytes(case.to_array()) & !keep | old & keep;
+            cell.copy_from_slice(&case.to_le_bytes());
+        } else {
+            cell.copy_from_slice(&case.to_array());
         }
-        cell.copy_from_slice(&case.to_le_bytes());
     }
 }
 
-/// Eight cube-edge pairs of a classified row, `row[x] | row[x + 1] << 1` in byte `x`, from its
-/// first nine bytes.
-#[inline(always)]
-fn pairs(row: &[u8]) -> u64 {
-    let word = |r: &[u8]| u64::from_le_bytes(r[..8].try_into().expect("eight bytes"));
-    word(row) | word(&row[1..]) << 1
-}
-
-/// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing eight
-/// bytes at a time: most of a row's span is unchanged, and a vertex is the rare event. Both
-/// slices run at least seven bytes past `end`: the last word is read whole and masked, so that
+/// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing a block
+/// of bytes at a time: most of a row's span is unchanged, and a vertex is the rare event. Both
+/// slices run at least fifteen bytes past `end`: the last block is read whole and masked, so that
 /// `f` has one call site and is inlined (called out of line, once per vertex, it cost a fifth of
 /// the vertex passes).
 #[inline]
@@ -864,34 +872,28 @@ fn for_each_differing(
     end: usize,
     mut f: impl FnMut(usize) -> Result<(), Error>,
 ) -> Result<(), Error> {
-    // Whole words from slices cut to whole words once: no bounds check per word.
-    let words = (end.max(start) - start).div_ceil(8);
-    let (a, b) = (&a[start..][..8 * words], &b[start..][..8 * words]);
-    for (w, (a, b)) in a.chunks_exact(8).zip(b.chunks_exact(8)).enumerate() {
-        let word = |r: &[u8]| u64::from_le_bytes(r.try_into().expect("eight bytes"));
-        let mut diff = word(a) ^ word(b);
-        let x = start + 8 * w;
-        if end - x < 8 {
-            diff &= within(end - x);
-        }
+    // Whole blocks from slices cut to whole blocks once: no bounds check per block.
+    let blocks = (end.max(start) - start).div_ceil(LANES);
+    let (a, b) = (&a[start..][..LANES * blocks], &b[start..][..LANES * blocks]);
+    for (w, (a, b)) in a.chunks_exact(LANES).zip(b.chunks_exact(LANES)).enumerate() {
+        let x = start + LANES * w;
+        let mut diff = !load(a).simd_eq(load(b)).to_bitmask() & lanes(end - x);
         while diff != 0 {
-            let byte = diff.trailing_zeros() as usize / 8;
-            f(x + byte)?;
-            diff &= !(0xFF << (8 * byte));
+            f(x + diff.trailing_zeros() as usize)?;
+            diff &= diff - 1;
         }
     }
     Ok(())
 }
 
-/// The first index whose byte differs from `v`, comparing eight bytes at a time.
+/// The first index whose byte differs from `v`, comparing a block of bytes at a time.
 fn first_differing(row: &[u8], v: u8) -> Option<usize> {
-    let splat = u64::from_ne_bytes([v; 8]);
-    let chunks = row.chunks_exact(8);
+    let chunks = row.chunks_exact(LANES);
     let tail = chunks.remainder();
     for (c, chunk) in chunks.enumerate() {
-        let d = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ splat;
+        let d = differing(chunk, v);
         if d != 0 {
-            return Some(c * 8 + d.trailing_zeros() as usize / 8);
+            return Some(c * LANES + d.trailing_zeros() as usize);
         }
     }
     tail.iter()
@@ -899,19 +901,24 @@ fn first_differing(row: &[u8], v: u8) -> Option<usize> {
         .map(|i| row.len() - tail.len() + i)
 }
 
-/// The last index whose byte differs from `v`, comparing eight bytes at a time.
+/// The last index whose byte differs from `v`, comparing a block of bytes at a time.
 fn last_differing(row: &[u8], v: u8) -> Option<usize> {
-    let splat = u64::from_ne_bytes([v; 8]);
-    let chunks = row.rchunks_exact(8);
+    let chunks = row.rchunks_exact(LANES);
     let head = chunks.remainder();
     for (c, chunk) in chunks.enumerate() {
-        let d = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ splat;
+        let d = differing(chunk, v);
         if d != 0 {
-            let start = row.len() - (c + 1) * 8;
-            return Some(start + (63 - d.leading_zeros() as usize) / 8);
+            let start = row.len() - (c + 1) * LANES;
+            return Some(start + 31 - d.leading_zeros() as usize);
         }
     }
     head.iter().rposition(|&b| b != v)
+}
+
+/// The bit mask of the bytes of a block that differ from `v`.
+#[inline(always)]
+fn differing(block: &[u8], v: u8) -> u32 {
+    !load(block).simd_eq(u8x16::splat(v)).to_bitmask() & lanes(LANES)
 }
 
 #[cfg(test)]
@@ -920,8 +927,8 @@ mod tests {
     use alloc::vec;
     use alloc::vec::Vec;
 
-    /// Rows mixing runs of 0 and 255 with crossed cases at every position of an eight-byte word,
-    /// each followed by seven crossed bytes that the scans must not report.
+    /// Rows mixing runs of 0 and 255 with crossed cases at every position of a block, each
+    /// followed by fifteen crossed bytes that the scans must not report.
     fn rows() -> impl Iterator<Item = (Vec<u8>, usize)> {
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
         (0..200).map(move |_| {
@@ -939,7 +946,7 @@ mod tests {
                 })
                 .collect();
             let len = row.len();
-            row.extend([7; 7]);
+            row.extend([7; 15]);
             (row, len)
         })
     }
@@ -970,7 +977,7 @@ mod tests {
         for _ in 0..50 {
             let rows: Vec<Vec<u8>> = (0..4)
                 .map(|_| {
-                    (0..41)
+                    (0..49)
                         .map(|_| {
                             state ^= state << 13;
                             state ^= state >> 7;
@@ -981,9 +988,9 @@ mod tests {
                 })
                 .collect();
             for len in 1usize..=37 {
-                let words = 8 * len.div_ceil(8);
-                let mut out = vec![0xAA; words];
-                let cut = |n: usize| &rows[n][..words + 1];
+                let blocks = 16 * len.div_ceil(16);
+                let mut out = vec![0xAA; blocks];
+                let cut = |n: usize| &rows[n][..blocks + 1];
                 cube_cases([cut(0), cut(1), cut(2), cut(3)], &mut out, len);
                 for (x, &case) in out.iter().enumerate() {
                     let plain =
@@ -1002,7 +1009,7 @@ mod tests {
         let all: Vec<(Vec<u8>, usize)> = rows().collect();
         for pair in all.windows(2) {
             let ((a, len), (b, _)) = (&pair[0], &pair[1]);
-            let b: Vec<u8> = b[..*len].iter().chain(&[8; 7]).copied().collect();
+            let b: Vec<u8> = b[..*len].iter().chain(&[8; 15]).copied().collect();
             for start in 0..*len {
                 for end in start..=*len {
                     let plain: Vec<usize> = (start..end).filter(|&x| a[x] != b[x]).collect();
