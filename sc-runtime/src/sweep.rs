@@ -58,7 +58,7 @@ struct Grid<'s> {
     cases: &'s mut [u8],
     /// `(lo, hi)` pairs: per classified row, the x-edge changes lie in `lo..hi` (`lo = nx − 1`,
     /// `hi = 0` for a uniform row); per cube row, the non-trivial cubes lie in `lo..hi`.
-    spans: &'s mut [u32],
+    spans: &'s mut [[u32; 2]],
     /// Where these samples sit in the whole grid: a block's vertices and triangles are reported
     /// in global indices, and the parity classes follow global indices.
     offset: [usize; 3],
@@ -110,7 +110,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 mergeable: params.tables.mergeable(),
                 filled,
                 cases,
-                spans,
+                spans: spans.as_chunks_mut().0,
                 offset: [0; 3],
                 own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
                 own_edges: dims.map(|n| (0, n)),
@@ -540,8 +540,8 @@ impl Grid<'_> {
 
     fn span(&self, row: usize) -> (usize, usize) {
         (
-            (self.spans[2 * row] & !END_BIT) as usize,
-            (self.spans[2 * row + 1] & !END_BIT) as usize,
+            (self.spans[row][0] & !END_BIT) as usize,
+            (self.spans[row][1] & !END_BIT) as usize,
         )
     }
 
@@ -549,14 +549,13 @@ impl Grid<'_> {
     /// then reads only the compact spans, not two cache lines of each row.
     fn ends(&self, row: usize) -> (u32, u32) {
         (
-            self.spans[2 * row] & END_BIT,
-            self.spans[2 * row + 1] & END_BIT,
+            self.spans[row][0] & END_BIT,
+            self.spans[row][1] & END_BIT,
         )
     }
 
     fn set_span(&mut self, row: usize, (lo, hi): (usize, usize)) {
-        self.spans[2 * row] = lo as u32;
-        self.spans[2 * row + 1] = hi as u32;
+        self.spans[row] = [lo as u32, hi as u32];
     }
 
     /// Step 1's classification of slice `z`, and each row's span of x-edge changes.
@@ -578,8 +577,8 @@ impl Grid<'_> {
             let (first, last) = (u32::from(row[0]) << 31, u32::from(row[nx - 1]) << 31);
             let r = self.slice_row(z, y);
             self.set_span(r, span);
-            self.spans[2 * r] |= first;
-            self.spans[2 * r + 1] |= last;
+            self.spans[r][0] |= first;
+            self.spans[r][1] |= last;
         }
     }
 
