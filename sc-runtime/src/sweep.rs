@@ -56,9 +56,12 @@ struct Grid<'s> {
     filled: &'s mut [u8],
     /// Three layers of cube cases, layer `k` at `k % 3`, row stride `nx`, then [`PAD`] bytes.
     cases: &'s mut [u8],
-    /// `(lo, hi)` pairs: per classified row, the x-edge changes lie in `lo..hi` (`lo = nx − 1`,
-    /// `hi = 0` for a uniform row); per cube row, the non-trivial cubes lie in `lo..hi`.
-    spans: &'s mut [[u32; 2]],
+    /// Per classified row (slice `z` at `z % 4`, `ny` rows each), the x-edge changes lie in
+    /// `lo..hi` (`lo = nx − 1`, `hi = 0` for a uniform row), with the row's first and last bytes
+    /// in the top bits (see [`union_span`]).
+    row_spans: &'s mut [Span],
+    /// Per cube row (layer `k` at `k % 3`), the non-trivial cubes lie in `lo..hi`.
+    case_spans: &'s mut [Span],
     /// Where these samples sit in the whole grid: a block's vertices and triangles are reported
     /// in global indices, and the parity classes follow global indices.
     offset: [usize; 3],
@@ -102,6 +105,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy + PAD);
         let (cases, merged) = rest.split_at_mut(3 * nxy + PAD);
         let (ids, spans) = scratch.words.split_at_mut(WORD_PLANES * nxy);
+        let (row_spans, case_spans) = spans.as_chunks_mut().0.split_at_mut(4 * dims[1]);
         Sweep {
             grid: Grid {
                 dims,
@@ -110,7 +114,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 mergeable: params.tables.mergeable(),
                 filled,
                 cases,
-                spans: spans.as_chunks_mut().0,
+                row_spans,
+                case_spans,
                 offset: [0; 3],
                 own_cubes: dims.map(|n| (0, n.saturating_sub(1))),
                 own_edges: dims.map(|n| (0, n)),
@@ -250,10 +255,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
         let [px, py, pz] = grid.offset.map(|o| o & 1);
+        let spans = grid.plane_spans(n);
         for y in 0..ny {
-            let (lo, hi) = grid.span(grid.slice_row(n, y));
+            let (lo, hi) = lo_hi(spans[y]);
             let (start, end) = if y + 1 < ny {
-                grid.union_span([(y, n), (y + 1, n)])
+                union_span([spans[y], spans[y + 1]], nx)
             } else {
                 (0, 0)
             };
@@ -305,8 +311,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
+        let (below, above) = (grid.plane_spans(k), grid.plane_spans(k + 1));
         for y in 0..ny {
-            let (start, end) = grid.union_span([(y, k), (y, k + 1)]);
+            let (start, end) = union_span([below[y], above[y]], nx);
             // As in `plane_vertices`: nothing is sliced for a row with nothing to scan.
             if start >= end {
                 continue;
@@ -355,8 +362,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let entries = grid.entries;
         let [ox, oy, oz] = grid.offset;
         let [(x_lo, x_hi), (y_lo, y_hi), _] = grid.own_cubes;
+        let spans = (k % 3) * ny;
         for j in y_lo..y_hi {
-            let (start, end) = grid.span(grid.case_row(k, j));
+            let (start, end) = lo_hi(grid.case_spans[spans + j]);
             let cases = &grid.cases[(k % 3) * nxy + j * nx..];
             let class_jk = ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
             let (start, end) = (start.max(x_lo), end.min(x_hi));
@@ -530,32 +538,11 @@ impl Grid<'_> {
         self.row(p[2], p[1])[p[0]] == 1
     }
 
-    fn slice_row(&self, z: usize, y: usize) -> usize {
-        (z % 4) * self.dims[1] + y
-    }
-
-    fn case_row(&self, k: usize, j: usize) -> usize {
-        4 * self.dims[1] + (k % 3) * self.dims[1] + j
-    }
-
-    fn span(&self, row: usize) -> (usize, usize) {
-        (
-            (self.spans[row][0] & !END_BIT) as usize,
-            (self.spans[row][1] & !END_BIT) as usize,
-        )
-    }
-
-    /// A classified row's first and last bytes, kept in its span's top bits: [`Grid::union_span`]
-    /// then reads only the compact spans, not two cache lines of each row.
-    fn ends(&self, row: usize) -> (u32, u32) {
-        (
-            self.spans[row][0] & END_BIT,
-            self.spans[row][1] & END_BIT,
-        )
-    }
-
-    fn set_span(&mut self, row: usize, (lo, hi): (usize, usize)) {
-        self.spans[row] = [lo as u32, hi as u32];
+    /// The spans of slice `z`'s classified rows.
+    #[inline(always)]
+    fn plane_spans(&self, z: usize) -> &[Span] {
+        let ny = self.dims[1];
+        &self.row_spans[(z % 4) * ny..][..ny]
     }
 
     /// Step 1's classification of slice `z`, and each row's span of x-edge changes.
@@ -575,33 +562,8 @@ impl Grid<'_> {
                 ),
             };
             let (first, last) = (u32::from(row[0]) << 31, u32::from(row[nx - 1]) << 31);
-            let r = self.slice_row(z, y);
-            self.set_span(r, span);
-            self.spans[r][0] |= first;
-            self.spans[r][1] |= last;
+            self.row_spans[(z % 4) * ny + y] = [span.0 as u32 | first, span.1 as u32 | last];
         }
-    }
-
-    /// The x range `start..end` outside which the rows `(y, z)` agree with each other and are
-    /// constant along x.
-    #[inline(always)]
-    fn union_span<const N: usize>(&self, rows: [(usize, usize); N]) -> (usize, usize) {
-        let nx = self.dims[0];
-        let (f0, f1) = self.ends(self.slice_row(rows[0].1, rows[0].0));
-        let (mut lo, mut hi) = (nx - 1, 0);
-        let (mut same0, mut same1) = (true, true);
-        for (y, z) in rows {
-            let row = self.slice_row(z, y);
-            let (l, h) = self.span(row);
-            lo = lo.min(l);
-            hi = hi.max(h);
-            let (e0, e1) = self.ends(row);
-            same0 &= e0 == f0;
-            same1 &= e1 == f1;
-        }
-        let start = if same0 { lo } else { 0 };
-        let end = if same1 { hi + 1 } else { nx };
-        (start, end.max(start))
     }
 
     /// Cube cases of layer `k`, over each cube row's span of non-trivial cubes.
@@ -609,25 +571,32 @@ impl Grid<'_> {
     #[inline(never)]
     fn compute_cases(&mut self, k: usize) {
         let [nx, ny, _] = self.dims;
+        let plane_spans = |z: usize| &self.row_spans[(z % 4) * ny..][..ny];
+        let (below, above) = (plane_spans(k), plane_spans(k + 1));
+        let spans = &mut self.case_spans[(k % 3) * ny..][..ny];
+        let plane = |z: usize| &self.filled[(z % 4) * nx * ny..];
+        let (lower, upper) = (plane(k), plane(k + 1));
+        let cases = &mut self.cases[(k % 3) * nx * ny..];
         for j in 0..ny - 1 {
-            let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)];
+            let four = [below[j], below[j + 1], above[j], above[j + 1]];
             // Points `start..end` may vary, so cubes `start..end - 1` may be non-trivial.
-            let (start, end) = self.union_span(rows);
-            let span = (start, (end.max(1) - 1).max(start));
-            self.set_span(self.case_row(k, j), span);
-            let (lo, hi) = span;
+            let (start, end) = union_span(four, nx);
+            let (lo, hi) = (start, (end.max(1) - 1).max(start));
+            spans[j] = [lo as u32, hi as u32];
             if lo >= hi {
                 continue;
             }
             // The rows run past `hi` into the next row or the padding (see `cube_cases`).
-            let blocks = (hi - lo).div_ceil(16);
-            let filled = &*self.filled;
-            let row = |n: usize| {
-                let (y, z) = rows[n];
-                &filled[(z % 4) * nx * ny + y * nx + lo..][..16 * blocks + 1]
-            };
-            let out = &mut self.cases[(k % 3) * nx * ny + j * nx + lo..][..16 * blocks];
-            cube_cases([row(0), row(1), row(2), row(3)], out, hi - lo);
+            let blocks = (hi - lo).div_ceil(LANES);
+            let (at, len) = (j * nx + lo, LANES * blocks + 1);
+            let out = &mut cases[at..][..LANES * blocks];
+            let rows = [
+                &lower[at..][..len],
+                &lower[at + nx..][..len],
+                &upper[at..][..len],
+                &upper[at + nx..][..len],
+            ];
+            cube_cases(rows, out, hi - lo);
         }
     }
 
@@ -782,6 +751,35 @@ impl Grid<'_> {
         let pick = |a: u32, b: u32| core::hint::select_unpredictable(shared, a, b);
         [pick(fa, fb), pick(ba, fa), pick(bb, ba)]
     }
+}
+
+/// A row's span as stored: `[lo, hi]`, and for a classified row its first and last bytes in the
+/// top bits ([`END_BIT`]), so that [`union_span`] reads only the compact spans, not two cache
+/// lines of each row.
+type Span = [u32; 2];
+
+/// A span's `lo..hi`, without the end bits.
+#[inline(always)]
+fn lo_hi([lo, hi]: Span) -> (usize, usize) {
+    ((lo & !END_BIT) as usize, (hi & !END_BIT) as usize)
+}
+
+/// The x range `start..end` outside which the classified rows of these spans agree with each
+/// other and are constant along x.
+#[inline(always)]
+fn union_span<const N: usize>(spans: [Span; N], nx: usize) -> (usize, usize) {
+    let (mut lo, mut hi) = (nx - 1, 0);
+    let (mut same0, mut same1) = (true, true);
+    for span in spans {
+        let (l, h) = lo_hi(span);
+        lo = lo.min(l);
+        hi = hi.max(h);
+        same0 &= (span[0] ^ spans[0][0]) & END_BIT == 0;
+        same1 &= (span[1] ^ spans[0][1]) & END_BIT == 0;
+    }
+    let start = if same0 { lo } else { 0 };
+    let end = if same1 { hi + 1 } else { nx };
+    (start, end.max(start))
 }
 
 /// Calls `f(x, case)` for each `x` in `start..end`, in order, whose cube the surface crosses (its
