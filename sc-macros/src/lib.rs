@@ -87,21 +87,14 @@ fn expand(input: &Input) -> Result<Tokens, String> {
             first.join("; ")
         ));
     }
-    let embedded = set
-        .classes
-        .iter()
-        .flat_map(|c| &c.cases)
-        .map(|e| packed(&e.triangles, &e.grey));
-    let paper = set
-        .classes
-        .iter()
-        .flat_map(|c| &c.cases)
-        .map(|e| match &e.paper {
-            Some(p) => packed(&p.triangles, &p.grey),
-            None => packed(&e.triangles, &e.grey),
-        });
-    let embedded: Vec<Tokens> = embedded.collect();
-    let paper: Vec<Tokens> = paper.collect();
+    let entries = || set.classes.iter().flat_map(|c| &c.cases).enumerate();
+    let embedded = entries().map(|(n, e)| packed(n / 256, &e.triangles, &e.grey));
+    let paper = entries().map(|(n, e)| match &e.paper {
+        Some(p) => packed(n / 256, &p.triangles, &p.grey),
+        None => packed(n / 256, &e.triangles, &e.grey),
+    });
+    let embedded: Vec<Tokens> = embedded.collect::<Result<_, _>>()?;
+    let paper: Vec<Tokens> = paper.collect::<Result<_, _>>()?;
     // One byte per entry, so the merge decision reads 2 KiB rather than the whole table.
     let mergeable = set.classes.iter().flat_map(|c| &c.cases).map(|e| {
         e.grey
@@ -152,8 +145,9 @@ fn check_shape(set: &TableSet) -> Result<(), String> {
     Ok(())
 }
 
-/// One runtime `Entry`: triangles padded to five, ears rotated to `[back, grey, forward]`.
-fn packed(triangles: &[[u8; 3]], grey: &[Grey]) -> Tokens {
+/// One runtime `Entry` of class `class`: triangles padded to five, ears rotated to
+/// `[back, grey, forward]`.
+fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, String> {
     let mut tris = [[0u8; 3]; 5];
     tris[..triangles.len()].copy_from_slice(triangles);
     let mut ears = [NO_EAR; 3];
@@ -177,8 +171,15 @@ fn packed(triangles: &[[u8; 3]], grey: &[Grey]) -> Tokens {
             .filter(|&axis| merged >> axis & 1 == 1 && ears[axis] != NO_EAR)
             .fold(all, |k, axis| k & !(1 << ears[axis]))
     });
+    let mut merge = [0u8; 3];
+    for axis in 0..3 {
+        if ears[axis] != NO_EAR {
+            merge[axis] = merge_byte(class, axis, tris[usize::from(ears[axis])])
+                .ok_or_else(|| format!("class {class}: the ear of grey axis {axis} does not cross the faces of its edge"))?;
+        }
+    }
     let tris = tris.iter().map(|[a, b, c]| quote!([#a, #b, #c]));
-    quote! {
+    Ok(quote! {
         ::sc_runtime::tables::Entry {
             tris: [#(#tris),*],
             count: #count,
@@ -186,8 +187,49 @@ fn packed(triangles: &[[u8; 3]], grey: &[Grey]) -> Tokens {
             mergeable: #mergeable,
             ear_axes: #ear_axes,
             kept: [#(#kept),*],
+            merge: [#(#merge),*],
         }
+    })
+}
+
+/// `Entry::merge` for the ear `[back, grey, forward]` of a grey edge along `axis` in a cube of
+/// class `class`: the ear's outer vertices lie one on each of the cube's two faces through the
+/// grey edge, and one of those faces is shared with the merge partner, the neighbour along the
+/// pairing axis (y for x-greys, x for y-greys, y or x for z-greys in even or odd layers). The
+/// grey edge lies on the cube's high face there if the cube owns the pair, on its low face if it
+/// is the partner. `None` if the outer vertices do not lie one on each face.
+fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Option<u8> {
+    let z_layer_odd = class >> 2 & 1 == 1;
+    let pairing = if axis == 0 || axis == 2 && !z_layer_odd {
+        1
+    } else {
+        0
+    };
+    // Whether cube edge `e` lies on the face where coordinate `d` is `side`.
+    let on_face = |e: u8, d: usize, side: u8| {
+        let (along, r) = (usize::from(e / 4), e % 4);
+        let fixed = match (along, d) {
+            (0, 1) | (1, 0) | (2, 0) => r & 1,
+            (0, 2) | (1, 2) | (2, 1) => r >> 1,
+            _ => return false,
+        };
+        fixed == side
+    };
+    let side = u8::from(on_face(grey, pairing, 1));
+    let (back_on, forward_on) = (
+        on_face(back, pairing, side),
+        on_face(forward, pairing, side),
+    );
+    if back_on == forward_on {
+        return None;
     }
+    Some(if side == 1 {
+        // The owner: which of its outer vertices is the shared one.
+        u8::from(back_on) << 4
+    } else {
+        // The partner: the outer vertex off the shared face.
+        if back_on { forward } else { back }
+    })
 }
 
 /// Mirrors `sc_runtime::tables::NO_EAR` (the macro cannot depend on the runtime it feeds).

@@ -16,7 +16,7 @@ use core::num::NonZeroU8;
 use wide::u8x16;
 
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
-use crate::tables::Entry;
+use crate::tables::{BACK_SHARED, Entry};
 use crate::vertex::{Field, sample_crossing};
 
 mod bound;
@@ -729,27 +729,33 @@ impl Grid<'_> {
         let nx = self.dims[0];
         let pclass = ((pi + ox) & 1) | ((pj + oy) & 1) << 1 | ((k + oz) & 1) << 2;
         let pentry = &self.entries[pclass * 256 + usize::from(self.case_at(pi, pj, k))];
+        // The partner adds the outer vertex of its ear that is off the face the two share; the
+        // entries say which (`Entry::merge`), so the partner's ear itself is not read.
+        let pat = pi + nx * pj;
+        let far = ids[edge_at[usize::from(pentry.merge[axis] & 15)] + pat];
         // An ear is stored `[back, grey, forward]`: only its two outer vertices matter.
-        let outer = |e: &Entry, at: usize| {
-            let [b, _, f] = e.tris[usize::from(e.ears[axis])];
-            (
-                ids[edge_at[usize::from(b & 15)] + at],
-                ids[edge_at[usize::from(f & 15)] + at],
-            )
-        };
-        let (ba, fa) = outer(entry, i + nx * j);
-        let (bb, fb) = outer(pentry, pi + nx * pj);
+        let [b, _, f] = entry.tris[usize::from(entry.ears[axis])];
+        let at = i + nx * j;
+        let (b, f) = (
+            ids[edge_at[usize::from(b & 15)] + at],
+            ids[edge_at[usize::from(f & 15)] + at],
+        );
+        // Which of this ear's vertices is shared is data: conditional moves, not a branch. One
+        // per vertex: a select between two arrays went through the stack, and loading the
+        // chosen array as one word waited for its separate stores (a fifth of the merged
+        // triangles' time).
+        let back_shared = entry.merge[axis] & BACK_SHARED != 0;
         debug_assert!(
-            ba == fb || bb == fa,
+            {
+                let [pb, _, pf] = pentry.tris[usize::from(pentry.ears[axis])];
+                let shared = if back_shared { b } else { f };
+                let id = |e: u8| ids[edge_at[usize::from(e & 15)] + pat];
+                [id(pb), id(pf)] == [far, shared] || [id(pb), id(pf)] == [shared, far]
+            },
             "ears around a merged grey edge share a face side"
         );
-        // Which ear's side the two share is data: conditional moves, not a branch. One per
-        // vertex: a select between two arrays went through the stack, and loading the chosen
-        // array as one word waited for its separate stores (a fifth of the merged triangles'
-        // time).
-        let shared = ba == fb;
-        let pick = |a: u32, b: u32| core::hint::select_unpredictable(shared, a, b);
-        [pick(fa, fb), pick(ba, fa), pick(bb, ba)]
+        let pick = |a: u32, b: u32| core::hint::select_unpredictable(back_shared, a, b);
+        [pick(f, far), pick(b, f), pick(far, b)]
     }
 }
 

@@ -29,7 +29,17 @@ pub struct Entry {
     /// bookkeeping is one load instead of a loop over the three axes (5 % of brainsmall's
     /// instructions).
     pub kept: [u8; 8],
+    /// Per grey axis with an ear, what Step 4 needs to put the merged triangle of the pair
+    /// together without reading the partner's ear. In the pair's owner (the lower cube along the
+    /// pairing axis), [`BACK_SHARED`] if the ear's back vertex lies on the face the two share;
+    /// in the partner, the edge of its ear's outer vertex off that face. Derived when the tables
+    /// are included.
+    pub merge: [u8; 3],
 }
+
+/// In an owner's [`Entry::merge`]: its ear's back vertex lies on the face it shares with the
+/// partner.
+pub const BACK_SHARED: u8 = 1 << 4;
 
 /// The two 2048-entry tables: the embedded one (Steps 1–3 and Embedded mode) and the paper one
 /// (forced folds nibbled greys-first anyway, for Paper mode). Index: `class * 256 + case`.
