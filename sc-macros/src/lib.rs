@@ -16,6 +16,7 @@ use std::path::PathBuf;
 use proc_macro::TokenStream;
 use proc_macro2::TokenStream as Tokens;
 use quote::quote;
+use sc_tablegen::cube::Face;
 use sc_tablegen::{Grey, TableSet};
 use syn::parse::{Parse, ParseStream};
 use syn::{Ident, LitStr};
@@ -205,27 +206,21 @@ fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Opti
     } else {
         0
     };
-    // Whether cube edge `e` lies on the face where coordinate `d` is `side`.
-    let on_face = |e: u8, d: usize, side: u8| {
-        let (along, r) = (usize::from(e / 4), e % 4);
-        let fixed = match (along, d) {
-            (0, 1) | (1, 0) | (2, 0) => r & 1,
-            (0, 2) | (1, 2) | (2, 1) => r >> 1,
-            _ => return false,
-        };
-        fixed == side
+    let face = |side: u8| Face {
+        axis: pairing,
+        side,
     };
-    let side = u8::from(on_face(grey, pairing, 1));
+    let side = u8::from(face(1).contains_edge(grey));
     let (back_on, forward_on) = (
-        on_face(back, pairing, side),
-        on_face(forward, pairing, side),
+        face(side).contains_edge(back),
+        face(side).contains_edge(forward),
     );
     if back_on == forward_on {
         return None;
     }
     Some(if side == 1 {
         // The owner: which of its outer vertices is the shared one.
-        u8::from(back_on) << 4
+        if back_on { BACK_SHARED } else { 0 }
     } else {
         // The partner: the outer vertex off the shared face.
         if back_on { forward } else { back }
@@ -234,6 +229,9 @@ fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Opti
 
 /// Mirrors `sc_runtime::tables::NO_EAR` (the macro cannot depend on the runtime it feeds).
 const NO_EAR: u8 = 0xFF;
+
+/// Mirrors `sc_runtime::tables::BACK_SHARED`.
+const BACK_SHARED: u8 = 1 << 4;
 
 #[cfg(test)]
 mod tests {

@@ -928,7 +928,7 @@ fn differing(block: &[u8], v: u8) -> u32 {
 
 #[cfg(test)]
 mod tests {
-    use super::{cube_cases, for_each_crossed, for_each_differing};
+    use super::{LANES, cube_cases, for_each_crossed, for_each_differing};
     use alloc::vec;
     use alloc::vec::Vec;
 
@@ -993,7 +993,7 @@ mod tests {
                 })
                 .collect();
             for len in 1usize..=37 {
-                let blocks = 16 * len.div_ceil(16);
+                let blocks = LANES * len.div_ceil(LANES);
                 let mut out = vec![0xAA; blocks];
                 let cut = |n: usize| &rows[n][..blocks + 1];
                 cube_cases([cut(0), cut(1), cut(2), cut(3)], &mut out, len);
