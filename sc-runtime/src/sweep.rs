@@ -44,6 +44,18 @@ enum Decision {
     Blocked,
 }
 
+/// The four cubes around an interior edge, by the first of them (see [`Grid::cubes_around`]);
+/// the others follow it at fixed steps, one along each of the two axes across the edge.
+#[derive(Clone, Copy)]
+struct Around {
+    /// The first cube's index in a plane of cubes, `j · nx + i`.
+    plane: usize,
+    /// The first cube's layer.
+    k: usize,
+    /// The first cube's parity class.
+    class: usize,
+}
+
 /// What the vertex and triangle passes read: classified slices, cube cases and row spans. Kept
 /// apart from [`Out`] so a pass can read rows while it writes vertex ids.
 struct Grid<'s> {
@@ -429,14 +441,29 @@ const OWNS: [u8; 8] = {
 };
 
 impl Out<'_> {
-    /// Marks the four cubes around the merged grey edge from `p` along `AXIS` (see
-    /// [`Out::merged`]).
+    /// Marks the four cubes around a merged grey edge along `AXIS` (see [`Out::merged`]). An x-
+    /// or y-edge's cubes lie in two layers, one of each parity, so two bytes each take both
+    /// layers' bits.
     #[inline(always)]
-    fn mark_merged<const AXIS: usize>(&mut self, grid: &Grid<'_>, p: [usize; 3]) {
-        let nx = grid.dims[0];
-        if let Some(cubes) = grid.cubes_around(p, AXIS) {
-            for (i, j, k) in cubes {
-                self.merged[j * nx + i] |= 1 << (3 * (k % 2) + AXIS);
+    fn mark_merged<const AXIS: usize>(&mut self, nx: usize, around: Around) {
+        match AXIS {
+            0 => {
+                let m = &mut self.merged[around.plane..][..nx + 1];
+                m[0] |= 0b1001;
+                m[nx] |= 0b1001;
+            }
+            1 => {
+                let m = &mut self.merged[around.plane..][..2];
+                m[0] |= 0b1001 << 1;
+                m[1] |= 0b1001 << 1;
+            }
+            _ => {
+                let bit = 1 << (3 * (around.k % 2) + 2);
+                let m = &mut self.merged[around.plane..][..nx + 2];
+                m[0] |= bit;
+                m[1] |= bit;
+                m[nx] |= bit;
+                m[nx + 1] |= bit;
             }
         }
     }
@@ -460,7 +487,8 @@ impl Out<'_> {
         self.stats.v13 += u64::from(counted);
         // Only a grey edge has a decision to count: three in four occupied edges skip it.
         if grey {
-            let mut decision = grid.decide::<AXIS>(p);
+            let around = grid.around::<AXIS>(p);
+            let mut decision = grid.decide::<AXIS>(p, around);
             let mut bounded = false;
             if decision == Decision::Merge
                 && let Some(bound) = params.max_error
@@ -474,8 +502,10 @@ impl Out<'_> {
                 self.stats.blocked += u64::from(decision == Decision::Blocked);
                 self.stats.bounded += u64::from(bounded);
             }
-            if decision == Decision::Merge {
-                self.mark_merged::<AXIS>(grid, p);
+            if decision == Decision::Merge
+                && let Some(around) = around
+            {
+                self.mark_merged::<AXIS>(grid.dims[0], around);
                 return Ok(MERGED);
             }
         }
@@ -636,26 +666,70 @@ impl Grid<'_> {
         ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2
     }
 
-    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5).
+    /// The four cubes around the edge from `p` along `AXIS`, if it is interior, as
+    /// [`Grid::cubes_around`] orders them.
     #[inline(always)]
-    fn decide<const AXIS: usize>(&self, p: [usize; 3]) -> Decision {
-        let axis = AXIS;
+    fn around<const AXIS: usize>(&self, p: [usize; 3]) -> Option<Around> {
+        let [l, m, n] = p;
+        let [nx, ny, nz] = self.dims;
+        let inside = |c: usize, len: usize| c >= 1 && c + 1 < len;
+        let (first, k) = match AXIS {
+            0 if inside(m, ny) && inside(n, nz) => ((l, m - 1), n - 1),
+            1 if inside(l, nx) && inside(n, nz) => ((l - 1, m), n - 1),
+            2 if inside(l, nx) && inside(m, ny) => ((l - 1, m - 1), n),
+            _ => return None,
+        };
+        Some(Around {
+            plane: first.1 * nx + first.0,
+            k,
+            class: self.class_of((first.0, first.1, k)),
+        })
+    }
+
+    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5), whose cubes
+    /// are `around`.
+    #[inline(always)]
+    fn decide<const AXIS: usize>(&self, p: [usize; 3], around: Option<Around>) -> Decision {
         if self.mode == Mode::Steps123 {
             return Decision::Keep;
         }
-        let Some(cubes) = self.cubes_around(p, axis) else {
+        let Some(Around { plane, k, class }) = around else {
             return Decision::Keep;
         };
         if self.mode == Mode::Paper {
             return Decision::Merge;
         }
+        let [nx, ny, _] = self.dims;
+        let layer = |k: usize| &self.cases[(k % 3) * nx * ny + plane..];
+        // The four cases, and how each cube's class differs from the first's: the cubes step
+        // by one along two axes, and a step flips that axis's parity bit.
+        let (cases, flips) = match AXIS {
+            0 => {
+                let (lo, hi) = (&layer(k)[..nx + 1], &layer(k + 1)[..nx + 1]);
+                ([lo[0], lo[nx], hi[0], hi[nx]], [0, 2, 4, 6])
+            }
+            1 => {
+                let (lo, hi) = (&layer(k)[..2], &layer(k + 1)[..2]);
+                ([lo[0], lo[1], hi[0], hi[1]], [0, 1, 4, 5])
+            }
+            _ => {
+                let c = &layer(k)[..nx + 2];
+                ([c[0], c[1], c[nx], c[nx + 1]], [0, 1, 2, 3])
+            }
+        };
+        debug_assert!(self.cubes_around(p, AXIS).is_some_and(|cubes| {
+            (0..4).all(|c| {
+                let (i, j, k) = cubes[c];
+                self.class_of((i, j, k)) == class ^ flips[c] && self.case_at(i, j, k) == cases[c]
+            })
+        }));
         // All four bits ANDed, not a short-circuit: one branch on the result instead of four
         // on the data.
-        let mergeable = cubes.iter().fold(1u8, |all, &(i, j, k)| {
-            let class = self.class_of((i, j, k));
-            all & self.mergeable[class * 256 + usize::from(self.case_at(i, j, k))] >> axis
-        });
-        if mergeable & 1 == 1 && !self.pinch(p, axis) {
+        let mut all = 1;
+        for (case, flip) in cases.into_iter().zip(flips) {
+            all &= self.mergeable[(class ^ flip) * 256 + usize::from(case)] >> AXIS;
+        }
+        if all & 1 == 1 && !self.pinch(p, AXIS) {
             Decision::Merge
         } else {
             Decision::Blocked
