@@ -375,6 +375,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [ox, oy, oz] = grid.offset;
         let [(x_lo, x_hi), (y_lo, y_hi), _] = grid.own_cubes;
         let spans = (k % 3) * ny;
+        let pairs = grid.partners(k);
         for j in y_lo..y_hi {
             let (start, end) = lo_hi(grid.case_spans[spans + j]);
             let cases = &grid.cases[(k % 3) * nxy + j * nx..];
@@ -401,7 +402,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
                         triangles += 1;
-                        let t = grid.merged_triangle(ids, [i, j, k], axis, entry, &edge_at);
+                        let cube = (at, &cases[i..], class);
+                        let t = grid.merged_triangle(ids, cube, axis, pairs[axis], entry, &edge_at);
                         sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
                 }
@@ -786,32 +788,39 @@ impl Grid<'_> {
         true
     }
 
+    /// Per grey-edge axis, where a merged pair's partner is from its owner in layer `k` (see
+    /// [`OWNS`]): its distance in a plane of cubes, and the parity bit that differs.
+    fn partners(&self, k: usize) -> [(usize, usize); 3] {
+        let (along_x, along_y) = ((1, 1), (self.dims[0], 2));
+        let z = if (k + self.offset[2]).is_multiple_of(2) {
+            along_y
+        } else {
+            along_x
+        };
+        [along_y, along_x, z]
+    }
+
     /// For a merged grey edge owned by this cube (see [`OWNS`]): the triangle that replaces its
-    /// ear and its partner's.
+    /// ear and its partner's. The cube is at `at` in its layer and `cases[0]`'s case; its partner
+    /// is `step` further on in both, with its class `flip`ped ([`Grid::partners`]).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn merged_triangle(
         &self,
         ids: &[u32],
-        [i, j, k]: [usize; 3],
+        (at, cases, class): (usize, &[u8], usize),
         axis: usize,
+        (step, flip): (usize, usize),
         entry: &Entry,
         edge_at: &[usize; 16],
     ) -> [u32; 3] {
-        let [ox, oy, oz] = self.offset;
-        // `&` and `|`, not `&&` and `||`: the axis is data, and a branch on it mispredicted on
-        // a fifth of the merged triangles.
-        let along_y = (axis == 0) | ((axis == 2) & (k + oz).is_multiple_of(2));
-        let (pi, pj) = (i + usize::from(!along_y), j + usize::from(along_y));
-        let nx = self.dims[0];
-        let pclass = ((pi + ox) & 1) | ((pj + oy) & 1) << 1 | ((k + oz) & 1) << 2;
-        let pentry = &self.entries[pclass * 256 + usize::from(self.case_at(pi, pj, k))];
+        let pentry = &self.entries[(class ^ flip) * 256 + usize::from(cases[step])];
         // The partner adds the outer vertex of its ear that is off the face the two share; the
         // entries say which (`Entry::merge`), so the partner's ear itself is not read.
-        let pat = pi + nx * pj;
+        let pat = at + step;
         let far = ids[edge_at[usize::from(pentry.merge[axis] & 15)] + pat];
         // An ear is stored `[back, grey, forward]`: only its two outer vertices matter.
         let [b, _, f] = entry.tris[usize::from(entry.ears[axis])];
-        let at = i + nx * j;
         let (b, f) = (
             ids[edge_at[usize::from(b & 15)] + at],
             ids[edge_at[usize::from(f & 15)] + at],
