@@ -34,12 +34,12 @@ pub(crate) trait Slices<T> {
 }
 
 /// What Step 4 does with an occupied grey edge.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 enum Decision {
     /// Not mergeable in this mode, or on the grid boundary.
     Keep,
     /// Merged: its vertex disappears and its four ears become two triangles.
-    Merge,
+    Merge(Around),
     /// Interior, but embedded mode's rules (a) or (b) forbid the merge.
     Blocked,
 }
@@ -489,10 +489,9 @@ impl Out<'_> {
         self.stats.v13 += u64::from(counted);
         // Only a grey edge has a decision to count: three in four occupied edges skip it.
         if grey {
-            let around = grid.around::<AXIS>(p);
-            let mut decision = grid.decide::<AXIS>(p, around);
+            let mut decision = grid.decide::<AXIS>(p);
             let mut bounded = false;
-            if decision == Decision::Merge
+            if let Decision::Merge(_) = decision
                 && let Some(bound) = params.max_error
                 && !grid.within_bound(p, AXIS, bound, field, params)
             {
@@ -500,13 +499,11 @@ impl Out<'_> {
                 bounded = true;
             }
             if counted {
-                self.stats.merged += u64::from(decision == Decision::Merge);
-                self.stats.blocked += u64::from(decision == Decision::Blocked);
+                self.stats.merged += u64::from(matches!(decision, Decision::Merge(_)));
+                self.stats.blocked += u64::from(matches!(decision, Decision::Blocked));
                 self.stats.bounded += u64::from(bounded);
             }
-            if decision == Decision::Merge
-                && let Some(around) = around
-            {
+            if let Decision::Merge(around) = decision {
                 self.mark_merged::<AXIS>(grid.dims[0], around);
                 return Ok(MERGED);
             }
@@ -688,19 +685,19 @@ impl Grid<'_> {
         })
     }
 
-    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5), whose cubes
-    /// are `around`.
+    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5).
     #[inline(always)]
-    fn decide<const AXIS: usize>(&self, p: [usize; 3], around: Option<Around>) -> Decision {
+    fn decide<const AXIS: usize>(&self, p: [usize; 3]) -> Decision {
         if self.mode == Mode::Steps123 {
             return Decision::Keep;
         }
-        let Some(Around { plane, k, class }) = around else {
+        let Some(around) = self.around::<AXIS>(p) else {
             return Decision::Keep;
         };
         if self.mode == Mode::Paper {
-            return Decision::Merge;
+            return Decision::Merge(around);
         }
+        let Around { plane, k, class } = around;
         let [nx, ny, _] = self.dims;
         let layer = |k: usize| &self.cases[(k % 3) * nx * ny + plane..];
         // The four cases, and how each cube's class differs from the first's: the cubes step
@@ -732,7 +729,7 @@ impl Grid<'_> {
             all &= self.mergeable[(class ^ flip) * 256 + usize::from(case)] >> AXIS;
         }
         if all & 1 == 1 && !self.pinch(p, AXIS) {
-            Decision::Merge
+            Decision::Merge(around)
         } else {
             Decision::Blocked
         }
