@@ -284,10 +284,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let values = &samples[y * nx..][..nx];
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
             let ids = xbase + y * nx;
+            let at = (&field, field.interior_row::<0>(y, n, params.normals));
             for_each_differing(row, &row[1..], lo, hi, |x| {
                 let ends = (values[x], values[x + 1]);
                 let id =
-                    out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, &field, sink)?;
+                    out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, at, sink)?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -295,11 +296,12 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
                 let ids = ybase + y * nx;
+                let at = (&field, field.interior_row::<1>(y, n, params.normals));
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
                     let ends = (values[x], next_values[x]);
                     let id =
-                        out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, &field, sink)?;
+                        out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, at, sink)?;
                     out.ids[ids + x] = id;
                     Ok(())
                 })?;
@@ -333,11 +335,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
             let ids = zbase + y * nx;
+            let at = (&field, field.interior_row::<2>(y, k, params.normals));
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
                 let ends = (lower[x], upper[x]);
-                let id =
-                    out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, &field, sink)?;
+                let id = out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, at, sink)?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -482,7 +484,7 @@ impl Out<'_> {
         p: [usize; 3],
         grey: bool,
         (a, b): (T, T),
-        field: &Field<'_, T>,
+        (field, row): (&Field<'_, T>, Option<usize>),
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
         let counted = self.emit && grid.owns_edge(p);
@@ -527,7 +529,7 @@ impl Out<'_> {
             let normal = if params.normals {
                 // Whether the lower end is filled, from its sample (the classification's test,
                 // exactly): its classified byte is a bounds-checked row away.
-                Some(field.normal::<AXIS>(p, t, a.to_f64() >= params.iso))
+                Some(field.normal::<AXIS>(row, p, t, a.to_f64() >= params.iso))
             } else {
                 None
             };

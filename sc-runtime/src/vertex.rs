@@ -107,23 +107,43 @@ impl<T: Scalar> Field<'_, T> {
         spacing.map(|s| [1.0 / s, 0.5 / s])
     }
 
-    /// The gradients at both ends of the edge from `p` along `AXIS` when both are inside the
-    /// grid, as nearly all are. The two ends share rows, so each axis's samples come from a few
-    /// windows of a row, bounds-checked once each: reading them point by point through
-    /// [`Field::gradient`] cost half of what normals cost. The arithmetic is
-    /// [`Field::gradient`]'s, so the normals are the same to the bit.
+    /// Where row `y` of slice `z` starts in a slice (`nx · y`), if every edge along `AXIS` in it
+    /// with both ends inside the grid has them inside in y and z too: the tests of
+    /// [`Field::interior_pair`] that hold for a whole row, taken once per row (and not at all
+    /// without `normals`).
     #[inline(always)]
-    fn interior_pair<const AXIS: usize>(&self, p: [usize; 3]) -> Option<([f64; 3], [f64; 3])> {
-        let [x, y, z] = p;
+    pub fn interior_row<const AXIS: usize>(
+        &self,
+        y: usize,
+        z: usize,
+        normals: bool,
+    ) -> Option<usize> {
         let [nx, ny, nz] = self.dims;
         let inside =
             |c: usize, n: usize, axis: usize| c >= 1 && c + 1 + usize::from(axis == AXIS) < n;
         // A pass's field starts one slice below the pass's `z` (see `Sweep::field`), so the
         // four slices are in place: no per-vertex lookup.
-        if !(inside(x, nx, 0) && inside(y, ny, 1) && inside(z, nz, 2) && z == self.first + 1) {
+        (normals && inside(y, ny, 1) && inside(z, nz, 2) && z == self.first + 1).then_some(nx * y)
+    }
+
+    /// The gradients at both ends of the edge from `x` along `AXIS` in the row that starts at
+    /// `row` ([`Field::interior_row`]) when both are inside the grid, as nearly all are. The two
+    /// ends share rows, so each axis's samples come from a few windows of a row, bounds-checked
+    /// once each: reading them point by point through [`Field::gradient`] cost half of what
+    /// normals cost. The arithmetic is [`Field::gradient`]'s, so the normals are the same to the
+    /// bit.
+    #[inline(always)]
+    fn interior_pair<const AXIS: usize>(
+        &self,
+        row: Option<usize>,
+        x: usize,
+    ) -> Option<([f64; 3], [f64; 3])> {
+        let nx = self.dims[0];
+        let row = row?;
+        if !(x >= 1 && x + 1 + usize::from(AXIS == 0) < nx) {
             return None;
         }
-        let i = nx * y + x;
+        let i = row + x;
         let d = |a: T, b: T, axis: usize| T::diff(a, b) * self.steps[axis][1];
         let [below, here, above, top] = self.slices;
         Some(match AXIS {
@@ -168,8 +188,14 @@ impl<T: Scalar> Field<'_, T> {
     /// Inlined into each vertex pass: as a call it spilled the pass's registers, and brainsmall's
     /// normals cost 10 % more time.
     #[inline(always)]
-    pub fn normal<const AXIS: usize>(&self, p: [usize; 3], t: f64, a_filled: bool) -> [f32; 3] {
-        let (ga, gb) = self.interior_pair::<AXIS>(p).unwrap_or_else(|| {
+    pub fn normal<const AXIS: usize>(
+        &self,
+        row: Option<usize>,
+        p: [usize; 3],
+        t: f64,
+        a_filled: bool,
+    ) -> [f32; 3] {
+        let (ga, gb) = self.interior_pair::<AXIS>(row, p[0]).unwrap_or_else(|| {
             let mut q = p;
             q[AXIS] += 1;
             (self.gradient(p), self.gradient(q))
@@ -248,7 +274,7 @@ mod tests {
             return 0;
         }
         let inside = |c: [usize; 3]| (0..3).all(|d| c[d] >= 1 && c[d] + 1 < field.dims[d]);
-        let pair = field.interior_pair::<AXIS>(p);
+        let pair = field.interior_pair::<AXIS>(field.interior_row::<AXIS>(p[1], p[2], true), p[0]);
         assert_eq!(pair.is_some(), inside(p) && inside(q), "{p:?} along {AXIS}");
         let Some((ga, gb)) = pair else { return 0 };
         let bits = |g: [f64; 3]| g.map(f64::to_bits);
