@@ -17,7 +17,7 @@ use wide::u8x16;
 
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::{BACK_SHARED, Entry};
-use crate::vertex::{Field, sample_crossing};
+use crate::vertex::{Field, InteriorRow, sample_crossing};
 
 mod bound;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
@@ -199,7 +199,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         self.grid.compute_cases(z0);
         self.first_layer = z0;
         self.out.emit = emit_plane;
-        let r = self.plane_vertices(z0, src, sink);
+        let r = if self.params.normals {
+            self.plane_vertices::<true>(z0, src, sink)
+        } else {
+            self.plane_vertices::<false>(z0, src, sink)
+        };
         self.out.emit = true;
         r
     }
@@ -219,8 +223,15 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         // Plane k + 1's merges start marking layer k + 1, whose bits layer k − 1 used.
         let stale = !(7u8 << (3 * ((k + 1) % 2)));
         self.out.merged.iter_mut().for_each(|m| *m &= stale);
-        self.z_vertices(k, src, sink)?;
-        self.plane_vertices(k + 1, src, sink)?;
+        // Each vertex pass in two copies, with and without normals: in one copy the normals'
+        // per-row state took registers from the other's scan.
+        if self.params.normals {
+            self.z_vertices::<true>(k, src, sink)?;
+            self.plane_vertices::<true>(k + 1, src, sink)?;
+        } else {
+            self.z_vertices::<false>(k, src, sink)?;
+            self.plane_vertices::<false>(k + 1, src, sink)?;
+        }
         let (own_lo, own_hi) = self.grid.own_cubes[2];
         if (own_lo..own_hi).contains(&k) {
             self.triangles(k, sink);
@@ -254,7 +265,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     /// Vertices on the x- and y-edges of plane `n`, row by row.
     // Not inlined: each pass runs once per layer, and apart it shows in a profile.
     #[inline(never)]
-    fn plane_vertices(
+    fn plane_vertices<const NORMALS: bool>(
         &mut self,
         n: usize,
         src: &impl Slices<T>,
@@ -284,11 +295,19 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let values = &samples[y * nx..][..nx];
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
             let ids = xbase + y * nx;
-            let at = (&field, field.interior_row::<0>(y, n, params.normals));
+            let normal_row = field.interior_row::<0>(y, n, NORMALS);
+            let at = (&field, &normal_row);
             for_each_differing(row, &row[1..], lo, hi, |x| {
                 let ends = (values[x], values[x + 1]);
-                let id =
-                    out.edge_vertex::<T, 0>(grid, params, [x, y, n], x_grey, ends, at, sink)?;
+                let id = out.edge_vertex::<T, 0, NORMALS>(
+                    grid,
+                    params,
+                    [x, y, n],
+                    x_grey,
+                    ends,
+                    at,
+                    sink,
+                )?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -296,12 +315,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
                 let ids = ybase + y * nx;
-                let at = (&field, field.interior_row::<1>(y, n, params.normals));
+                let normal_row = field.interior_row::<1>(y, n, NORMALS);
+                let at = (&field, &normal_row);
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
                     let ends = (values[x], next_values[x]);
-                    let id =
-                        out.edge_vertex::<T, 1>(grid, params, [x, y, n], grey, ends, at, sink)?;
+                    let id = out.edge_vertex::<T, 1, NORMALS>(
+                        grid,
+                        params,
+                        [x, y, n],
+                        grey,
+                        ends,
+                        at,
+                        sink,
+                    )?;
                     out.ids[ids + x] = id;
                     Ok(())
                 })?;
@@ -313,7 +340,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     /// Vertices on the z-edges of layer `k`, row by row.
     // Not inlined: each pass runs once per layer, and apart it shows in a profile.
     #[inline(never)]
-    fn z_vertices(
+    fn z_vertices<const NORMALS: bool>(
         &mut self,
         k: usize,
         src: &impl Slices<T>,
@@ -335,11 +362,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
             let ids = zbase + y * nx;
-            let at = (&field, field.interior_row::<2>(y, k, params.normals));
+            let normal_row = field.interior_row::<2>(y, k, NORMALS);
+            let at = (&field, &normal_row);
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
                 let ends = (lower[x], upper[x]);
-                let id = out.edge_vertex::<T, 2>(grid, params, [x, y, k], grey, ends, at, sink)?;
+                let id = out.edge_vertex::<T, 2, NORMALS>(
+                    grid,
+                    params,
+                    [x, y, k],
+                    grey,
+                    ends,
+                    at,
+                    sink,
+                )?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -477,14 +513,14 @@ impl Out<'_> {
     /// caller reads the edge's two samples straight from its rows.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn edge_vertex<T: Scalar, const AXIS: usize>(
+    fn edge_vertex<T: Scalar, const AXIS: usize, const NORMALS: bool>(
         &mut self,
         grid: &Grid<'_>,
         params: &Params,
         p: [usize; 3],
         grey: bool,
         (a, b): (T, T),
-        (field, row): (&Field<'_, T>, Option<usize>),
+        (field, row): (&Field<'_, T>, &Option<InteriorRow<'_, '_, T, AXIS>>),
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
         let counted = self.emit && grid.owns_edge(p);
@@ -526,10 +562,10 @@ impl Out<'_> {
             });
             // An `if`, not `bool::then` with a closure: in the Python extension's build the
             // closure was left out of line, three calls per vertex and 40 % more normals time.
-            let normal = if params.normals {
+            let normal = if NORMALS {
                 // Whether the lower end is filled, from its sample (the classification's test,
                 // exactly): its classified byte is a bounds-checked row away.
-                Some(field.normal::<AXIS>(row, p, t, a.to_f64() >= params.iso))
+                Some(field.normal::<AXIS>(*row, p, t, a.to_f64() >= params.iso))
             } else {
                 None
             };
