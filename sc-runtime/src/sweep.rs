@@ -998,9 +998,15 @@ fn for_each_differing(
     // Whole blocks from slices cut to whole blocks once: no bounds check per block.
     let blocks = (end.max(start) - start).div_ceil(LANES);
     let (a, b) = (&a[start..][..LANES * blocks], &b[start..][..LANES * blocks]);
-    for (w, (a, b)) in a.chunks_exact(LANES).zip(b.chunks_exact(LANES)).enumerate() {
-        let x = start + LANES * w;
-        let mut diff = !load(a).simd_eq(load(b)).to_bitmask() & lanes(end - x);
+    let mut scan = a.chunks_exact(LANES).zip(b.chunks_exact(LANES)).enumerate();
+    // Blocks without a difference are passed over in a loop of their own, whose few registers
+    // `f` does not take: in one loop with `f`, every block reloaded the scan's state from the
+    // stack.
+    let differing = |(w, (a, b)): (usize, (&[u8], &[u8]))| {
+        let diff = !load(a).simd_eq(load(b)).to_bitmask() & lanes(end - start - LANES * w);
+        (diff != 0).then_some((start + LANES * w, diff))
+    };
+    while let Some((x, mut diff)) = scan.find_map(differing) {
         while diff != 0 {
             f(x + diff.trailing_zeros() as usize)?;
             diff &= diff - 1;
