@@ -296,18 +296,10 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
             let ids = xbase + y * nx;
             let normal_row = field.interior_row::<0>(y, n, NORMALS);
-            let at = (&field, &normal_row);
+            let at = (grid, params, &field, &normal_row);
             for_each_differing(row, &row[1..], lo, hi, |x| {
                 let ends = (values[x], values[x + 1]);
-                let id = out.edge_vertex::<T, 0, NORMALS>(
-                    grid,
-                    params,
-                    [x, y, n],
-                    x_grey,
-                    ends,
-                    at,
-                    sink,
-                )?;
+                let id = out.edge_vertex::<T, 0, NORMALS>(at, [x, y, n], x_grey, ends, sink)?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -316,19 +308,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let next_values = &samples[(y + 1) * nx..][..nx];
                 let ids = ybase + y * nx;
                 let normal_row = field.interior_row::<1>(y, n, NORMALS);
-                let at = (&field, &normal_row);
+                let at = (grid, params, &field, &normal_row);
                 for_each_differing(row, next, start, end, |x| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
                     let ends = (values[x], next_values[x]);
-                    let id = out.edge_vertex::<T, 1, NORMALS>(
-                        grid,
-                        params,
-                        [x, y, n],
-                        grey,
-                        ends,
-                        at,
-                        sink,
-                    )?;
+                    let id = out.edge_vertex::<T, 1, NORMALS>(at, [x, y, n], grey, ends, sink)?;
                     out.ids[ids + x] = id;
                     Ok(())
                 })?;
@@ -363,19 +347,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
             let ids = zbase + y * nx;
             let normal_row = field.interior_row::<2>(y, k, NORMALS);
-            let at = (&field, &normal_row);
+            let at = (grid, params, &field, &normal_row);
             for_each_differing(below, above, start, end, |x| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
                 let ends = (lower[x], upper[x]);
-                let id = out.edge_vertex::<T, 2, NORMALS>(
-                    grid,
-                    params,
-                    [x, y, k],
-                    grey,
-                    ends,
-                    at,
-                    sink,
-                )?;
+                let id = out.edge_vertex::<T, 2, NORMALS>(at, [x, y, k], grey, ends, sink)?;
                 out.ids[ids + x] = id;
                 Ok(())
             })?;
@@ -480,6 +456,15 @@ const OWNS: [u8; 8] = {
     owns
 };
 
+/// What a vertex pass hands [`Out::edge_vertex`] for every edge of a row: the grid, the
+/// parameters, the samples' field and, for normals, the row's view of it.
+type RowContext<'a, 'v, T, const AXIS: usize> = (
+    &'a Grid<'a>,
+    &'a Params,
+    &'a Field<'v, T>,
+    &'a Option<InteriorRow<'a, 'v, T, AXIS>>,
+);
+
 impl Out<'_> {
     /// Marks the four cubes around a merged grey edge along `AXIS` (see [`Out::merged`]). An x-
     /// or y-edge's cubes lie in two layers, one of each parity, so two bytes each take both
@@ -511,16 +496,13 @@ impl Out<'_> {
     /// Occupied edge bookkeeping shared by all three edge kinds: count, decide, number. The
     /// axis is a constant so each pass gets its own copy with the axis tests folded away; the
     /// caller reads the edge's two samples straight from its rows.
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn edge_vertex<T: Scalar, const AXIS: usize, const NORMALS: bool>(
         &mut self,
-        grid: &Grid<'_>,
-        params: &Params,
+        (grid, params, field, row): RowContext<'_, '_, T, AXIS>,
         p: [usize; 3],
         grey: bool,
         (a, b): (T, T),
-        (field, row): (&Field<'_, T>, &Option<InteriorRow<'_, '_, T, AXIS>>),
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
         let counted = self.emit && grid.owns_edge(p);
@@ -838,7 +820,6 @@ impl Grid<'_> {
     /// For a merged grey edge owned by this cube (see [`OWNS`]): the triangle that replaces its
     /// ear and its partner's. The cube is at `at` in its layer and `cases[0]`'s case; its partner
     /// is `step` further on in both, with its class `flip`ped ([`Grid::partners`]).
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn merged_triangle(
         &self,
