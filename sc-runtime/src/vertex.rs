@@ -253,8 +253,8 @@ mod tests {
     use alloc::vec::Vec;
 
     /// On a small pseudo-random volume with uneven spacing, every edge whose ends are both inside
-    /// the grid gets from its row's [`InteriorRow::pair`] exactly, to the bit, the two gradients the
-    /// general [`Field::gradient`] gives; every other edge is left to the general path.
+    /// the grid gets from its row's [`InteriorRow::pair`] exactly, to the bit, the two gradients
+    /// the general [`Field::gradient`] gives; every other edge is left to the general path.
     #[test]
     fn row_pairs_match_the_general_gradient() {
         let dims = [6, 5, 7];
