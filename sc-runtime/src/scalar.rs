@@ -17,6 +17,12 @@ pub trait Scalar: Copy + Send + Sync + 'static {
     fn diff(a: Self, b: Self) -> f64 {
         b.to_f64() - a.to_f64()
     }
+    /// [`Scalar::diff`] rounded to `f32`, for normals. Integer types of up to 16 bits subtract
+    /// and convert exactly.
+    #[inline]
+    fn diff32(a: Self, b: Self) -> f32 {
+        Self::diff(a, b) as f32
+    }
     /// Step 1 over a row: `out[i]` is 1 where `row[i]` is filled, else 0. A type may override
     /// it to take per-row decisions out of the loop, so that the loop vectorises.
     #[inline]
@@ -50,6 +56,10 @@ macro_rules! int_scalar {
             #[inline]
             fn diff(a: $t, b: $t) -> f64 {
                 (<$wide>::from(b) - <$wide>::from(a)) as f64
+            }
+            #[inline]
+            fn diff32(a: $t, b: $t) -> f32 {
+                (<$wide>::from(b) - <$wide>::from(a)) as f32
             }
             #[inline]
             fn classify_row(row: &[$t], t: Option<$t>, out: &mut [u8]) {

@@ -17,7 +17,7 @@ use wide::u8x16;
 
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::{BACK_SHARED, Entry};
-use crate::vertex::{Field, InteriorRow, sample_crossing};
+use crate::vertex::{Field, InteriorRow, Steps, wide_crossing};
 
 mod bound;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
@@ -108,7 +108,7 @@ pub(crate) struct Sweep<'s, T: Scalar> {
     /// The layer `start` prepared: where this sweep's output began.
     first_layer: usize,
     /// The gradient's reciprocal steps, computed once.
-    steps: [[f64; 2]; 3],
+    steps: Steps,
 }
 
 impl<'s, T: Scalar> Sweep<'s, T> {
@@ -143,7 +143,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             params: *params,
             threshold: T::threshold(params.iso),
             first_layer: 0,
-            steps: Field::<T>::steps(params.spacing),
+            steps: Steps::new(params.spacing),
         }
     }
 
@@ -535,30 +535,45 @@ impl Out<'_> {
         self.next_id += 1;
         if self.emit {
             self.stats.vertices += u64::from(counted);
-            let t = sample_crossing(a, b, params.iso);
-            let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
-            let pos: [f32; 3] = core::array::from_fn(|d| {
-                // Through i64: one instruction, where usize to f64 takes several; exact below 2^53.
-                let c = global[d] as i64 as f64 + if d == AXIS { t } else { 0.0 };
-                (params.origin[d] + c * params.spacing[d]) as f32
-            });
+            let ends = (a.to_f64(), b.to_f64());
+            let t = wide_crossing(ends.0, ends.1, params.iso);
             // An `if`, not `bool::then` with a closure: in the Python extension's build the
             // closure was left out of line, three calls per vertex and 40 % more normals time.
             let normal = if NORMALS {
                 // Whether the lower end is filled, from its sample (the classification's test,
                 // exactly): its classified byte is a bounds-checked row away.
-                Some(field.normal::<AXIS>(*row, p, t, a.to_f64() >= params.iso))
+                Some(field.normal::<AXIS>(*row, p, t, ends.0 >= params.iso))
             } else {
                 None
             };
-            sink.edge_vertex(global, AXIS, pos, normal);
-            if params.values {
-                let (a, b) = (a.to_f64(), b.to_f64());
-                // As NumPy's `maximum`: a NaN end gives NaN.
-                sink.vertex_value((if a > b || a.is_nan() { a } else { b }) as f32);
-            }
+            send::<AXIS>(grid, params, p, t, normal, ends, sink);
         }
         Ok(id)
+    }
+}
+
+/// Sends the vertex `t` along the edge from `p` along `AXIS`, whose samples are `(a, b)`, with
+/// its value when [`Params::values`] asks for one.
+#[inline(always)]
+fn send<const AXIS: usize>(
+    grid: &Grid<'_>,
+    params: &Params,
+    p: [usize; 3],
+    t: f64,
+    normal: Option<[f32; 3]>,
+    (a, b): (f64, f64),
+    sink: &mut impl Sink,
+) {
+    let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
+    let pos: [f32; 3] = core::array::from_fn(|d| {
+        // Through i64: one instruction, where usize to f64 takes several; exact below 2^53.
+        let c = global[d] as i64 as f64 + if d == AXIS { t } else { 0.0 };
+        (params.origin[d] + c * params.spacing[d]) as f32
+    });
+    sink.edge_vertex(global, AXIS, pos, normal);
+    if params.values {
+        // As NumPy's `maximum`: a NaN end gives NaN.
+        sink.vertex_value((if a > b || a.is_nan() { a } else { b }) as f32);
     }
 }
 
