@@ -20,7 +20,9 @@ use crate::tables::{BACK_SHARED, Entry};
 use crate::vertex::{Field, InteriorRow, Steps, wide_crossing};
 
 mod bound;
+mod cube_ids;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
+use cube_ids::{Cube, CubeIds};
 
 /// The top bit of a classified row's span words: its first and last bytes (see `Grid::ends`).
 const END_BIT: u32 = 1 << 31;
@@ -234,7 +236,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         }
         let (own_lo, own_hi) = self.grid.own_cubes[2];
         if (own_lo..own_hi).contains(&k) {
-            self.triangles(k, sink);
+            if self.grid.mode == Mode::Steps123 {
+                self.triangles::<false>(k, sink);
+            } else {
+                self.triangles::<true>(k, sink);
+            }
         }
         if self.out.emit {
             // Layers done since this sweep started, and the ones left, extrapolate the output.
@@ -359,32 +365,19 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         Ok(())
     }
 
-    /// Steps 3 and 4: each cube's table triangles, with the ears of merged grey edges replaced.
+    /// Steps 3 and 4: each cube's table triangles, with the ears of merged grey edges replaced
+    /// (`MERGING`, a constant so that Steps 1–3 get a copy without the merge marks).
     // Not inlined: each pass runs once per layer, and apart it shows in a profile.
     #[inline(never)]
-    fn triangles(&mut self, k: usize, sink: &mut impl Sink) {
+    fn triangles<const MERGING: bool>(&mut self, k: usize, sink: &mut impl Sink) {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
-        let (lo, hi) = (k % 2, (k + 1) % 2);
-        // Where each cube-local edge's vertex id lives, relative to the cube's `i + nx * j`;
-        // sixteen entries, so that an edge number masked with 15 needs no bounds check.
-        let edge_at: [usize; 16] = core::array::from_fn(|e| {
-            let r = e % 4;
-            let (a, b) = (r & 1, r >> 1);
-            match e / 4 {
-                0 => [lo, hi][b] * 2 * nxy + a * nx,
-                1 => [lo, hi][b] * 2 * nxy + nxy + a,
-                2 => 4 * nxy + a + b * nx,
-                _ => 0,
-            }
-        });
         let grid = &self.grid;
-        let ids = &*self.out.ids;
+        let ids = CubeIds::new(self.out.ids, grid.dims, k);
         let (marks, shift) = (&*self.out.merged, 3 * (k % 2));
         // Counted in locals, added to the stats once: stores to the stats on every cube could
         // not be moved past the loop's bounds checks.
         let (mut t13, mut triangles) = (0u64, 0u64);
-        let merging = grid.mode != Mode::Steps123;
         let entries = grid.entries;
         let [ox, oy, oz] = grid.offset;
         let [(x_lo, x_hi), (y_lo, y_hi), _] = grid.own_cubes;
@@ -403,12 +396,16 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let entry = &entries[class * 256 + usize::from(case)];
                 t13 += u64::from(entry.count);
                 let at = i + nx * j;
-                let id = |e: u8| ids[edge_at[usize::from(e & 15)] + at];
+                // Every cube the scan visits is one: the test is what lets the ids be read
+                // unchecked.
+                let Some(cube) = ids.cube(at) else {
+                    return;
+                };
                 // A merged grey edge's ear is dropped; the pair's owner emits the merged
                 // triangle in its place (its partner emits nothing). Table lookups rather than
                 // branches: which greys merged is data, and data-dependent branches mispredict.
                 let mut kept = entry.kept[0];
-                if merging {
+                if MERGING {
                     let marks = usize::from(marks[at] >> shift & 7);
                     kept = entry.kept[marks];
                     let mut owned = marks as u8 & entry.ear_axes & OWNS[class];
@@ -416,8 +413,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
                         triangles += 1;
-                        let cube = (at, &cases[i..], class);
-                        let t = grid.merged_triangle(ids, cube, axis, pairs[axis], entry, &edge_at);
+                        let owner = (cube, &cases[i..], class);
+                        let t = grid.merged_triangle(owner, axis, pairs[axis], entry);
                         sink.cube_triangle([i + ox, j + oy, k + oz], t);
                     }
                 }
@@ -429,7 +426,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                     kept &= kept - 1;
                     triangles += 1;
                     let [a, b, c] = entry.tris[n];
-                    sink.cube_triangle([i + ox, j + oy, k + oz], [id(a), id(b), id(c)]);
+                    let t = [cube.id(a), cube.id(b), cube.id(c)];
+                    sink.cube_triangle([i + ox, j + oy, k + oz], t);
                 }
             });
         }
@@ -833,29 +831,23 @@ impl Grid<'_> {
     }
 
     /// For a merged grey edge owned by this cube (see [`OWNS`]): the triangle that replaces its
-    /// ear and its partner's. The cube is at `at` in its layer and `cases[0]`'s case; its partner
-    /// is `step` further on in both, with its class `flip`ped ([`Grid::partners`]).
+    /// ear and its partner's. The cube's case is `cases[0]`; its partner is `step` further on in
+    /// the cases and the ids, with its class `flip`ped ([`Grid::partners`]).
     #[inline(always)]
     fn merged_triangle(
         &self,
-        ids: &[u32],
-        (at, cases, class): (usize, &[u8], usize),
+        (cube, cases, class): (Cube<'_, '_>, &[u8], usize),
         axis: usize,
         (step, flip): (usize, usize),
         entry: &Entry,
-        edge_at: &[usize; 16],
     ) -> [u32; 3] {
         let pentry = &self.entries[(class ^ flip) * 256 + usize::from(cases[step])];
         // The partner adds the outer vertex of its ear that is off the face the two share; the
         // entries say which (`Entry::merge`), so the partner's ear itself is not read.
-        let pat = at + step;
-        let far = ids[edge_at[usize::from(pentry.merge[axis] & 15)] + pat];
+        let far = cube.next_id(step, pentry.merge[axis]);
         // An ear is stored `[back, grey, forward]`: only its two outer vertices matter.
         let [b, _, f] = entry.tris[usize::from(entry.ears[axis])];
-        let (b, f) = (
-            ids[edge_at[usize::from(b & 15)] + at],
-            ids[edge_at[usize::from(f & 15)] + at],
-        );
+        let (b, f) = (cube.id(b), cube.id(f));
         // Which of this ear's vertices is shared is data: conditional moves, not a branch. One
         // per vertex: a select between two arrays went through the stack, and loading the
         // chosen array as one word waited for its separate stores (a fifth of the merged
@@ -865,8 +857,8 @@ impl Grid<'_> {
             {
                 let [pb, _, pf] = pentry.tris[usize::from(pentry.ears[axis])];
                 let shared = if back_shared { b } else { f };
-                let id = |e: u8| ids[edge_at[usize::from(e & 15)] + pat];
-                [id(pb), id(pf)] == [far, shared] || [id(pb), id(pf)] == [shared, far]
+                let ear = [cube.next_id(step, pb), cube.next_id(step, pf)];
+                ear == [far, shared] || ear == [shared, far]
             },
             "ears around a merged grey edge share a face side"
         );
