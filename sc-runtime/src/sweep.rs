@@ -373,8 +373,8 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
         let grid = &self.grid;
-        let ids = CubeIds::new(self.out.ids, grid.dims, k);
-        let (marks, shift) = (&*self.out.merged, 3 * (k % 2));
+        let ids = CubeIds::new(self.out.ids, self.out.merged, grid.dims, k);
+        let shift = 3 * (k % 2);
         // Counted in locals, added to the stats once: stores to the stats on every cube could
         // not be moved past the loop's bounds checks.
         let (mut t13, mut triangles) = (0u64, 0u64);
@@ -406,7 +406,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 // branches: which greys merged is data, and data-dependent branches mispredict.
                 let mut kept = entry.kept[0];
                 if MERGING {
-                    let marks = usize::from(marks[at] >> shift & 7);
+                    let marks = usize::from(cube.marks() >> shift & 7);
                     kept = entry.kept[marks];
                     let mut owned = marks as u8 & entry.ear_axes & OWNS[class];
                     while owned != 0 {

@@ -1,10 +1,13 @@
-//! The triangle pass's reads of vertex ids, by cube and cube-local edge, with one bounds test per
-//! cube instead of one per vertex: a sixth of what a triangle cost.
+//! The triangle pass's reads of vertex ids and merge marks, by cube, with one bounds test per cube
+//! instead of one per read: a sixth of what a triangle cost.
 
-/// The vertex ids around the cubes of one layer: the id planes the vertex passes wrote, and for
-/// each cube-local edge where its id lies relative to the cube's `i + nx · j`.
+/// The vertex ids and merge marks of the cubes of one layer: the id planes the vertex passes
+/// wrote, for each cube-local edge where its id lies relative to the cube's `i + nx · j`, and the
+/// marks.
 pub(super) struct CubeIds<'a> {
     ids: &'a [u32],
+    /// The merge marks, a byte per cube (`Out::merged`), at least `cubes` of them.
+    marks: &'a [u8],
     /// Sixteen entries, so that an edge number masked with 15 needs no test. Each offset is
     /// followed by at least `cubes` ids ([`CubeIds::new`] makes sure).
     edge_at: [usize; 16],
@@ -15,8 +18,8 @@ pub(super) struct CubeIds<'a> {
 impl<'a> CubeIds<'a> {
     /// The ids of layer `k`'s cubes, laid out as the vertex passes write them: the x- and
     /// y-edges of plane `z` at `2 · nx · ny · (z % 2)` and `nx · ny` after it, the layer's z-edges
-    /// at `4 · nx · ny`. `ids` holds the five planes (`WORD_PLANES`).
-    pub fn new(ids: &'a [u32], dims: [usize; 3], k: usize) -> CubeIds<'a> {
+    /// at `4 · nx · ny`. `ids` holds the five planes (`WORD_PLANES`), `marks` a plane.
+    pub fn new(ids: &'a [u32], marks: &'a [u8], dims: [usize; 3], k: usize) -> CubeIds<'a> {
         let [nx, ny, _] = dims;
         let plane = nx * ny;
         let cubes = plane.saturating_sub(nx + 1);
@@ -31,15 +34,16 @@ impl<'a> CubeIds<'a> {
                 _ => 0,
             }
         });
-        // Holds for every layer: the largest offset is `4 · nx · ny + nx + 1`, and `ids` holds
-        // five planes. Tested once per layer, since the reads below rely on it.
+        // Holds for every layer: the largest offset is `4 · nx · ny + nx + 1`, `ids` holds five
+        // planes and `marks` one. Tested once per layer, since the reads below rely on it.
         let room = ids.len().checked_sub(cubes);
         assert!(
-            room.is_some_and(|room| edge_at.iter().all(|&o| o <= room)),
-            "the id planes hold layer {k}'s vertices"
+            room.is_some_and(|room| edge_at.iter().all(|&o| o <= room)) && marks.len() >= cubes,
+            "the id planes and marks hold layer {k}'s cubes"
         );
         CubeIds {
             ids,
+            marks,
             edge_at,
             cubes,
         }
@@ -52,7 +56,7 @@ impl<'a> CubeIds<'a> {
     }
 }
 
-/// One cube's vertex ids.
+/// One cube's vertex ids and merge marks.
 #[derive(Clone, Copy)]
 pub(super) struct Cube<'c, 'a> {
     ids: &'c CubeIds<'a>,
@@ -69,6 +73,13 @@ impl Cube<'_, '_> {
         // SAFETY: `at < cubes` (`CubeIds::cube`) and every offset is at most
         // `ids.len() − cubes` (`CubeIds::new`), so `i < ids.len()`.
         unsafe { *ids.get_unchecked(i) }
+    }
+
+    /// The cube's merge marks.
+    #[inline(always)]
+    pub fn marks(&self) -> u8 {
+        // SAFETY: `at < cubes <= marks.len()` (`CubeIds::cube`, `CubeIds::new`).
+        unsafe { *self.ids.marks.get_unchecked(self.at) }
     }
 
     /// The id of the vertex on edge `edge` of the cube `step` further on in the layer: a merged
