@@ -48,24 +48,25 @@ pub(crate) fn wide_crossing(a: f64, b: f64, iso: f64) -> f64 {
     }
 }
 
-/// The square root: `std`'s where it is linked, which compiles to one instruction the optimiser
-/// sees through; `libm`'s (the same correctly rounded result) otherwise.
-#[inline(always)]
-fn sqrt(x: f64) -> f64 {
-    #[cfg(feature = "std")]
-    return x.sqrt();
-    #[cfg(not(feature = "std"))]
-    return libm::sqrt(x);
-}
+/// Square roots: `std`'s where it is linked, which compile to one instruction the optimiser sees
+/// through; `libm`'s (the same correctly rounded results) otherwise.
+#[cfg(feature = "std")]
+mod root {
+    #[inline(always)]
+    pub fn sqrt(x: f64) -> f64 {
+        x.sqrt()
+    }
 
-/// [`sqrt`] in `f32`.
-#[inline(always)]
-fn sqrtf(x: f32) -> f32 {
-    #[cfg(feature = "std")]
-    return x.sqrt();
-    #[cfg(not(feature = "std"))]
-    return libm::sqrtf(x);
+    #[inline(always)]
+    pub fn sqrtf(x: f32) -> f32 {
+        x.sqrt()
+    }
 }
+#[cfg(not(feature = "std"))]
+mod root {
+    pub use libm::{sqrt, sqrtf};
+}
+use root::{sqrt, sqrtf};
 
 /// The gradient's reciprocal steps, per axis, for one-sided and central differences, relative to
 /// the smallest spacing: a normal is a direction, so one scale for all three axes does not change
