@@ -1,5 +1,5 @@
 //! The triangle pass's reads of vertex ids and merge marks, by cube, with one bounds test per cube
-//! instead of one per read: a sixth of what a triangle cost.
+//! instead of one per read: about a seventh of what a triangle cost.
 
 /// The vertex ids and merge marks of the cubes of one layer: the id planes the vertex passes
 /// wrote, for each cube-local edge where its id lies relative to the cube's `i + nx · j`, and the
