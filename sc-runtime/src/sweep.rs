@@ -21,8 +21,10 @@ use crate::vertex::{Field, InteriorRow, Steps, wide_crossing};
 
 mod bound;
 mod cube_ids;
+mod edge_row;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
 use cube_ids::{Cube, CubeIds};
+use edge_row::EdgeRow;
 
 /// The top bit of a classified row's span words: its first and last bytes (see `Grid::ends`).
 const END_BIT: u32 = 1 << 31;
@@ -90,8 +92,6 @@ struct Grid<'s> {
 
 /// Vertex numbering and counts.
 struct Out<'s> {
-    /// Two planes of x- then y-edge ids (plane `n` at `n % 2`), then one layer of z-edge ids.
-    ids: &'s mut [u32],
     /// Merge marks of two layers of cubes in one byte per cube: bit `3 · (k % 2) + axis` set iff
     /// that grey edge of the cube in layer `k` merged. The triangle pass reads one byte per cube
     /// instead of three vertex ids.
@@ -105,6 +105,9 @@ struct Out<'s> {
 pub(crate) struct Sweep<'s, T: Scalar> {
     grid: Grid<'s>,
     out: Out<'s>,
+    /// Two planes of x- then y-edge ids (plane `n` at `n % 2`), then one layer of z-edge ids:
+    /// apart from [`Out`], so that a vertex pass can hold a row of them while it numbers.
+    ids: &'s mut [u32],
     params: Params,
     threshold: T::Threshold,
     /// The layer `start` prepared: where this sweep's output began.
@@ -136,12 +139,12 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 restricted: false,
             },
             out: Out {
-                ids,
                 merged: &mut merged[..nxy],
                 next_id: 0,
                 emit: true,
                 stats: Stats::default(),
             },
+            ids,
             params: *params,
             threshold: T::threshold(params.iso),
             first_layer: 0,
@@ -280,7 +283,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [nx, ny, _] = self.grid.dims;
         let field = self.field(src, n, n);
         let samples = src.slice(n);
-        let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
+        let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
         let [px, py, pz] = grid.offset.map(|o| o & 1);
@@ -300,27 +303,21 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let row = grid.padded_row(n, y);
             let values = &samples[y * nx..][..nx];
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
-            let ids = xbase + y * nx;
-            let normal_row = field.interior_row::<0>(y, n, NORMALS);
-            let at = (grid, params, &field, &normal_row);
-            for_each_differing(row, &row[1..], lo, hi, |x| {
-                let ends = (values[x], values[x + 1]);
-                let id = out.edge_vertex::<T, 0, NORMALS>(at, [x, y, n], x_grey, ends, sink)?;
-                out.ids[ids + x] = id;
-                Ok(())
-            })?;
+            let at = RowContext::<T, 0>::new(grid, params, &field, y, n, NORMALS);
+            EdgeRow::new(values, &values[1..], &mut ids[xbase + y * nx..][..nx]).scan(
+                (row, &row[1..]),
+                lo,
+                hi,
+                |x, ends| out.edge_vertex::<T, 0, NORMALS>(&at, [x, y, n], x_grey, ends, sink),
+            )?;
             if y + 1 < ny {
                 let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
-                let ids = ybase + y * nx;
-                let normal_row = field.interior_row::<1>(y, n, NORMALS);
-                let at = (grid, params, &field, &normal_row);
-                for_each_differing(row, next, start, end, |x| {
+                let at = RowContext::<T, 1>::new(grid, params, &field, y, n, NORMALS);
+                let mut edges = EdgeRow::new(values, next_values, &mut ids[ybase + y * nx..][..nx]);
+                edges.scan((row, next), start, end, |x, ends| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
-                    let ends = (values[x], next_values[x]);
-                    let id = out.edge_vertex::<T, 1, NORMALS>(at, [x, y, n], grey, ends, sink)?;
-                    out.ids[ids + x] = id;
-                    Ok(())
+                    out.edge_vertex::<T, 1, NORMALS>(&at, [x, y, n], grey, ends, sink)
                 })?;
             }
         }
@@ -339,7 +336,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [nx, ny, _] = self.grid.dims;
         let field = self.field(src, k, k + 1);
         let (lower, upper) = (src.slice(k), src.slice(k + 1));
-        let (grid, out, params) = (&self.grid, &mut self.out, &self.params);
+        let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
         let (below, above) = (grid.plane_spans(k), grid.plane_spans(k + 1));
@@ -351,15 +348,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             }
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
-            let ids = zbase + y * nx;
-            let normal_row = field.interior_row::<2>(y, k, NORMALS);
-            let at = (grid, params, &field, &normal_row);
-            for_each_differing(below, above, start, end, |x| {
+            let at = RowContext::<T, 2>::new(grid, params, &field, y, k, NORMALS);
+            let mut edges = EdgeRow::new(lower, upper, &mut ids[zbase + y * nx..][..nx]);
+            edges.scan((below, above), start, end, |x, ends| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
-                let ends = (lower[x], upper[x]);
-                let id = out.edge_vertex::<T, 2, NORMALS>(at, [x, y, k], grey, ends, sink)?;
-                out.ids[ids + x] = id;
-                Ok(())
+                out.edge_vertex::<T, 2, NORMALS>(&at, [x, y, k], grey, ends, sink)
             })?;
         }
         Ok(())
@@ -373,7 +366,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
         let grid = &self.grid;
-        let ids = CubeIds::new(self.out.ids, self.out.merged, grid.dims, k);
+        let ids = CubeIds::new(self.ids, self.out.merged, grid.dims, k);
         let shift = 3 * (k % 2);
         // Counted in locals, added to the stats once: stores to the stats on every cube could
         // not be moved past the loop's bounds checks.
@@ -454,14 +447,47 @@ const OWNS: [u8; 8] = {
     owns
 };
 
-/// What a vertex pass hands [`Out::edge_vertex`] for every edge of a row: the grid, the
-/// parameters, the samples' field and, for normals, the row's view of it.
-type RowContext<'a, 'v, T, const AXIS: usize> = (
-    &'a Grid<'a>,
-    &'a Params,
-    &'a Field<'v, T>,
-    &'a Option<InteriorRow<'a, 'v, T, AXIS>>,
-);
+/// What a vertex pass hands [`Out::edge_vertex`] for every edge along `AXIS` of a row.
+struct RowContext<'a, 'v, T, const AXIS: usize> {
+    grid: &'a Grid<'a>,
+    params: &'a Params,
+    /// The samples, for the bound on Step 4 and for normals.
+    field: &'a Field<'v, T>,
+    /// For normals, the row's unchecked view of the field.
+    normals: Option<InteriorRow<'a, 'v, T, AXIS>>,
+    /// The row's y and z in world units, in lanes 1 and 2 (lane 0 is unused): the coordinates its
+    /// vertices share except along their edge's axis, computed once per row as [`send`] would
+    /// per vertex.
+    fixed: [f32; 3],
+}
+
+impl<'a, 'v, T: Scalar, const AXIS: usize> RowContext<'a, 'v, T, AXIS> {
+    /// The context of row `y` of plane `z`.
+    #[inline(always)]
+    fn new(
+        grid: &'a Grid<'a>,
+        params: &'a Params,
+        field: &'a Field<'v, T>,
+        y: usize,
+        z: usize,
+        normals: bool,
+    ) -> Self {
+        let world = |d: usize, c: usize| world(params, d, (c + grid.offset[d]) as i64 as f64);
+        RowContext {
+            grid,
+            params,
+            field,
+            normals: field.interior_row::<AXIS>(y, z, normals),
+            fixed: [0.0, world(1, y), world(2, z)],
+        }
+    }
+}
+
+/// Grid coordinate `c` along axis `d` in world units.
+#[inline(always)]
+fn world(params: &Params, d: usize, c: f64) -> f32 {
+    (params.origin[d] + c * params.spacing[d]) as f32
+}
 
 impl Out<'_> {
     /// Marks the four cubes around a merged grey edge along `AXIS` (see [`Out::merged`]). An x-
@@ -497,12 +523,18 @@ impl Out<'_> {
     #[inline(always)]
     fn edge_vertex<T: Scalar, const AXIS: usize, const NORMALS: bool>(
         &mut self,
-        (grid, params, field, row): RowContext<'_, '_, T, AXIS>,
+        row: &RowContext<'_, '_, T, AXIS>,
         p: [usize; 3],
         grey: bool,
         (a, b): (T, T),
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
+        let RowContext {
+            grid,
+            params,
+            field,
+            ..
+        } = *row;
         let counted = self.emit && grid.owns_edge(p);
         self.stats.v13 += u64::from(counted);
         // Only a grey edge has a decision to count: three in four occupied edges skip it.
@@ -540,11 +572,11 @@ impl Out<'_> {
             let normal = if NORMALS {
                 // Whether the lower end is filled, from its sample (the classification's test,
                 // exactly): its classified byte is a bounds-checked row away.
-                Some(field.normal::<AXIS>(*row, p, t, ends.0 >= params.iso))
+                Some(field.normal::<AXIS>(row.normals, p, t, ends.0 >= params.iso))
             } else {
                 None
             };
-            send::<AXIS>(grid, params, p, t, normal, ends, sink);
+            send(row, p, t, normal, ends, sink);
         }
         Ok(id)
     }
@@ -553,20 +585,24 @@ impl Out<'_> {
 /// Sends the vertex `t` along the edge from `p` along `AXIS`, whose samples are `(a, b)`, with
 /// its value when [`Params::values`] asks for one.
 #[inline(always)]
-fn send<const AXIS: usize>(
-    grid: &Grid<'_>,
-    params: &Params,
+fn send<T, const AXIS: usize>(
+    row: &RowContext<'_, '_, T, AXIS>,
     p: [usize; 3],
     t: f64,
     normal: Option<[f32; 3]>,
     (a, b): (f64, f64),
     sink: &mut impl Sink,
 ) {
+    let RowContext { grid, params, .. } = *row;
     let global: [usize; 3] = core::array::from_fn(|d| p[d] + grid.offset[d]);
     let pos: [f32; 3] = core::array::from_fn(|d| {
         // Through i64: one instruction, where usize to f64 takes several; exact below 2^53.
-        let c = global[d] as i64 as f64 + if d == AXIS { t } else { 0.0 };
-        (params.origin[d] + c * params.spacing[d]) as f32
+        let c = global[d] as i64 as f64;
+        match d {
+            _ if d == AXIS => world(params, d, c + t),
+            0 => world(params, d, c),
+            _ => row.fixed[d],
+        }
     });
     sink.edge_vertex(global, AXIS, pos, normal);
     if params.values {
