@@ -22,9 +22,11 @@ use crate::vertex::{Field, InteriorRow, Steps, wide_crossing};
 mod bound;
 mod cube_ids;
 mod edge_row;
+mod greys;
 use crate::{Error, Mode, Params, Scalar, Sink, Stats};
 use cube_ids::{Cube, CubeIds};
 use edge_row::EdgeRow;
+use greys::Greys;
 
 /// The top bit of a classified row's span words: its first and last bytes (see `Grid::ends`).
 const END_BIT: u32 = 1 << 31;
@@ -284,6 +286,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let field = self.field(src, n, n);
         let samples = src.slice(n);
         let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
+        let (x_greys, y_greys) = (Greys::<0>::new(grid, n), Greys::<1>::new(grid, n));
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
         let [px, py, pz] = grid.offset.map(|o| o & 1);
@@ -303,7 +306,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let row = grid.padded_row(n, y);
             let values = &samples[y * nx..][..nx];
             let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
-            let at = RowContext::<T, 0>::new(grid, params, &field, y, n, NORMALS);
+            let at = RowContext::new(grid, params, &field, x_greys.as_ref(), y, n, NORMALS);
             EdgeRow::new(values, &values[1..], &mut ids[xbase + y * nx..][..nx]).scan(
                 (row, &row[1..]),
                 lo,
@@ -313,7 +316,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             if y + 1 < ny {
                 let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
-                let at = RowContext::<T, 1>::new(grid, params, &field, y, n, NORMALS);
+                let at = RowContext::new(grid, params, &field, y_greys.as_ref(), y, n, NORMALS);
                 let mut edges = EdgeRow::new(values, next_values, &mut ids[ybase + y * nx..][..nx]);
                 edges.scan((row, next), start, end, |x, ends| {
                     let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
@@ -337,6 +340,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let field = self.field(src, k, k + 1);
         let (lower, upper) = (src.slice(k), src.slice(k + 1));
         let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
+        let greys = Greys::<2>::new(grid, k);
         let zbase = 4 * nx * ny;
         let [px, py, _] = grid.offset.map(|o| o & 1);
         let (below, above) = (grid.plane_spans(k), grid.plane_spans(k + 1));
@@ -348,7 +352,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             }
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
-            let at = RowContext::<T, 2>::new(grid, params, &field, y, k, NORMALS);
+            let at = RowContext::new(grid, params, &field, greys.as_ref(), y, k, NORMALS);
             let mut edges = EdgeRow::new(lower, upper, &mut ids[zbase + y * nx..][..nx]);
             edges.scan((below, above), start, end, |x, ends| {
                 let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
@@ -455,6 +459,8 @@ struct RowContext<'a, 'v, T, const AXIS: usize> {
     field: &'a Field<'v, T>,
     /// For normals, the row's unchecked view of the field.
     normals: Option<InteriorRow<'a, 'v, T, AXIS>>,
+    /// For Step 4, the plane's grey edges.
+    greys: Option<&'a Greys<'a, AXIS>>,
     /// The row's y and z in world units, in lanes 1 and 2 (lane 0 is unused): the coordinates its
     /// vertices share except along their edge's axis, computed once per row as [`send`] would
     /// per vertex.
@@ -468,6 +474,7 @@ impl<'a, 'v, T: Scalar, const AXIS: usize> RowContext<'a, 'v, T, AXIS> {
         grid: &'a Grid<'a>,
         params: &'a Params,
         field: &'a Field<'v, T>,
+        greys: Option<&'a Greys<'a, AXIS>>,
         y: usize,
         z: usize,
         normals: bool,
@@ -478,6 +485,7 @@ impl<'a, 'v, T: Scalar, const AXIS: usize> RowContext<'a, 'v, T, AXIS> {
             params,
             field,
             normals: field.interior_row::<AXIS>(y, z, normals),
+            greys,
             fixed: [0.0, world(1, y), world(2, z)],
         }
     }
@@ -537,9 +545,10 @@ impl Out<'_> {
         } = *row;
         let counted = self.emit && grid.owns_edge(p);
         self.stats.v13 += u64::from(counted);
-        // Only a grey edge has a decision to count: three in four occupied edges skip it.
-        if grey {
-            let mut decision = grid.decide::<AXIS>(p);
+        // Only a grey edge has a decision to count: three in four occupied edges skip it. Where
+        // the row has no `greys`, each would be kept.
+        if grey && let Some(greys) = &row.greys {
+            let mut decision = greys.decide(p[0], p[1]);
             let mut bounded = false;
             if let Decision::Merge(_) = decision
                 && let Some(bound) = params.max_error
@@ -732,76 +741,6 @@ impl Grid<'_> {
     fn class_of(&self, (i, j, k): (usize, usize, usize)) -> usize {
         let [ox, oy, oz] = self.offset;
         ((i + ox) & 1) | ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2
-    }
-
-    /// The four cubes around the edge from `p` along `AXIS`, if it is interior, as
-    /// [`Grid::cubes_around`] orders them.
-    #[inline(always)]
-    fn around<const AXIS: usize>(&self, p: [usize; 3]) -> Option<Around> {
-        let [l, m, n] = p;
-        let [nx, ny, nz] = self.dims;
-        let inside = |c: usize, len: usize| c >= 1 && c + 1 < len;
-        let (first, k) = match AXIS {
-            0 if inside(m, ny) && inside(n, nz) => ((l, m - 1), n - 1),
-            1 if inside(l, nx) && inside(n, nz) => ((l - 1, m), n - 1),
-            2 if inside(l, nx) && inside(m, ny) => ((l - 1, m - 1), n),
-            _ => return None,
-        };
-        Some(Around {
-            plane: first.1 * nx + first.0,
-            k,
-            class: self.class_of((first.0, first.1, k)),
-        })
-    }
-
-    /// Step 4's decision for the occupied grey edge from `p` along `AXIS` (SPEC §5).
-    #[inline(always)]
-    fn decide<const AXIS: usize>(&self, p: [usize; 3]) -> Decision {
-        if self.mode == Mode::Steps123 {
-            return Decision::Keep;
-        }
-        let Some(around) = self.around::<AXIS>(p) else {
-            return Decision::Keep;
-        };
-        if self.mode == Mode::Paper {
-            return Decision::Merge(around);
-        }
-        let Around { plane, k, class } = around;
-        let [nx, ny, _] = self.dims;
-        let layer = |k: usize| &self.cases[(k % 3) * nx * ny + plane..];
-        // The four cases, and how each cube's class differs from the first's: the cubes step
-        // by one along two axes, and a step flips that axis's parity bit.
-        let (cases, flips) = match AXIS {
-            0 => {
-                let (lo, hi) = (&layer(k)[..nx + 1], &layer(k + 1)[..nx + 1]);
-                ([lo[0], lo[nx], hi[0], hi[nx]], [0, 2, 4, 6])
-            }
-            1 => {
-                let (lo, hi) = (&layer(k)[..2], &layer(k + 1)[..2]);
-                ([lo[0], lo[1], hi[0], hi[1]], [0, 1, 4, 5])
-            }
-            _ => {
-                let c = &layer(k)[..nx + 2];
-                ([c[0], c[1], c[nx], c[nx + 1]], [0, 1, 2, 3])
-            }
-        };
-        debug_assert!(self.cubes_around(p, AXIS).is_some_and(|cubes| {
-            (0..4).all(|c| {
-                let (i, j, k) = cubes[c];
-                self.class_of((i, j, k)) == class ^ flips[c] && self.case_at(i, j, k) == cases[c]
-            })
-        }));
-        // All four bits ANDed, not a short-circuit: one branch on the result instead of four
-        // on the data.
-        let mut all = 1;
-        for (case, flip) in cases.into_iter().zip(flips) {
-            all &= self.mergeable[(class ^ flip) * 256 + usize::from(case)] >> AXIS;
-        }
-        if all & 1 == 1 && !self.pinch(p, AXIS) {
-            Decision::Merge(around)
-        } else {
-            Decision::Blocked
-        }
     }
 
     /// SPEC §5 (b): the lower end `p` is cut off in every face of its fan: all four faces of the

@@ -1,0 +1,142 @@
+//! Step 4's decisions for the grey edges of one plane (SPEC §5), from layers of cube cases and
+//! planes of classified samples looked up once per plane. Per edge, `Grid::decide` had looked
+//! them up by their `z` (a division by 3 or 4 each), sliced rows with their bounds tests and
+//! tested which mode it ran in.
+
+use super::{Around, Decision, Grid};
+use crate::Mode;
+
+/// The grey edges along `AXIS` of plane `z` (for z-edges, of layer `z`) whose four cubes lie
+/// inside the grid as far as `z` tells. An edge's first cube (see `Grid::cubes_around`) is one
+/// step below it along each of the two other axes.
+pub(super) struct Greys<'g, const AXIS: usize> {
+    grid: &'g Grid<'g>,
+    /// The layer of cases of the first two cubes and the one of the other two, from the first
+    /// cube's `j · nx + i`: the four are `[cases[0][c], cases[0][c + s], cases[1][c],
+    /// cases[1][c + s]]`, with `s` one cube along y for x-edges and along x for the others.
+    cases: [&'g [u8]; 2],
+    /// The first cube's layer, and its parity class at `i = j = 0`.
+    k: usize,
+    class: usize,
+    /// For SPEC §5 (b), classified samples: plane `z`, then planes `z − 1` and `z + 1` (z-edges
+    /// inside the grid only, else empty).
+    filled: [&'g [u8]; 3],
+}
+
+/// How a cube's class differs from the first cube's, in [`Greys::cases`]' order.
+const FLIPS: [[usize; 4]; 3] = [[0, 2, 4, 6], [0, 1, 4, 5], [0, 1, 2, 3]];
+
+impl<'g, const AXIS: usize> Greys<'g, AXIS> {
+    /// The grey edges of plane (or layer) `z`, if Step 4 may merge any of them: not in Steps
+    /// 1–3, nor where `z` puts the cubes around them outside the grid.
+    pub fn new(grid: &'g Grid<'g>, z: usize) -> Option<Self> {
+        let [nx, ny, nz] = grid.dims;
+        let inside = |c: usize, n: usize| c >= 1 && c + 1 < n;
+        if grid.mode == Mode::Steps123 || (AXIS != 2 && !inside(z, nz)) {
+            return None;
+        }
+        let plane = nx * ny;
+        let k = if AXIS == 2 { z } else { z - 1 };
+        let layer = |k: usize| &grid.cases[(k % 3) * plane..][..plane];
+        let cases = match AXIS {
+            2 => [layer(k), &layer(k)[nx..]],
+            _ => [layer(k), layer(k + 1)],
+        };
+        let filled = |z: usize| &grid.filled[(z % 4) * plane..][..plane];
+        let (below, above) = if AXIS == 2 && inside(z, nz) {
+            (filled(z - 1), filled(z + 1))
+        } else {
+            (&[][..], &[][..])
+        };
+        Some(Greys {
+            grid,
+            cases,
+            k,
+            class: grid.class_of((0, 0, k)),
+            filled: [filled(z), below, above],
+        })
+    }
+
+    /// Step 4's decision for the occupied grey edge from `(x, y)` in the plane.
+    #[inline(always)]
+    pub fn decide(&self, x: usize, y: usize) -> Decision {
+        let [nx, ny, _] = self.grid.dims;
+        let inside = |c: usize, n: usize| c >= 1 && c + 1 < n;
+        let interior = match AXIS {
+            0 => inside(y, ny),
+            1 => inside(x, nx),
+            _ => inside(x, nx) && inside(y, ny),
+        };
+        if !interior {
+            return Decision::Keep;
+        }
+        let (i, j) = (x - usize::from(AXIS != 0), y - usize::from(AXIS != 1));
+        let at = j * nx + i;
+        let around = Around {
+            plane: at,
+            k: self.k,
+            class: self.class ^ (i & 1) ^ (j & 1) << 1,
+        };
+        if self.grid.mode == Mode::Paper {
+            return Decision::Merge(around);
+        }
+        let s = if AXIS == 0 { nx } else { 1 };
+        let [a, b] = self.cases;
+        let cases = [a[at], a[at + s], b[at], b[at + s]];
+        debug_assert!(
+            self.grid
+                .cubes_around([x, y, self.z()], AXIS)
+                .is_some_and(|cubes| {
+                    (0..4).all(|c| {
+                        let (i, j, k) = cubes[c];
+                        self.grid.class_of((i, j, k)) == around.class ^ FLIPS[AXIS][c]
+                            && self.grid.case_at(i, j, k) == cases[c]
+                    })
+                })
+        );
+        // All four bits ANDed, not a short-circuit: one branch on the result instead of four
+        // on the data.
+        let mut all = 1;
+        for (case, flip) in cases.into_iter().zip(FLIPS[AXIS]) {
+            let class = (around.class ^ flip) & 7;
+            all &= self.grid.mergeable[class * 256 + usize::from(case)] >> AXIS;
+        }
+        if all & 1 == 1 && !self.pinch(x, y) {
+            Decision::Merge(around)
+        } else {
+            Decision::Blocked
+        }
+    }
+
+    /// `Grid::pinch` for the edge from `(x, y)`: the lower end's neighbours in the plane (x- and
+    /// y-edges) all differ from it and, if it is empty, its four diagonal neighbours are filled;
+    /// for z-edges, its six neighbours all differ from it.
+    #[inline(always)]
+    fn pinch(&self, x: usize, y: usize) -> bool {
+        let [nx, ny, _] = self.grid.dims;
+        let [here, below, above] = self.filled;
+        if !(x >= 1 && x + 1 < nx && y >= 1 && y + 1 < ny) || AXIS == 2 && below.is_empty() {
+            return false;
+        }
+        let p = y * nx + x;
+        let centre = here[p];
+        let faces = here[p - 1] != centre
+            && here[p + 1] != centre
+            && here[p - nx] != centre
+            && here[p + nx] != centre;
+        let pinch = if AXIS == 2 {
+            faces && below[p] != centre && above[p] != centre
+        } else {
+            let diagonals =
+                here[p - nx - 1] & here[p - nx + 1] & here[p + nx - 1] & here[p + nx + 1];
+            faces && (centre == 1 || diagonals == 1)
+        };
+        debug_assert_eq!(pinch, self.grid.pinch([x, y, self.z()], AXIS));
+        pinch
+    }
+
+    /// The plane's `z`, for the checks against `Grid`'s functions of a point.
+    fn z(&self) -> usize {
+        if AXIS == 2 { self.k } else { self.k + 1 }
+    }
+}
