@@ -227,9 +227,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 .classify::<T>(k + 2, src.slice(k + 2), self.threshold);
             self.grid.compute_cases(k + 1);
         }
-        // Plane k + 1's merges start marking layer k + 1, whose bits layer k − 1 used.
-        let stale = !(7u8 << (3 * ((k + 1) % 2)));
-        self.out.merged.iter_mut().for_each(|m| *m &= stale);
+        // Plane k + 1's merges start marking layer k + 1, whose bits layer k − 1 used: they lie
+        // on cubes around merged grey edges, crossed cubes, so within layer k − 1's case spans.
+        // Clearing the whole plane cost 1 % of brainsmall's instructions.
+        if k >= 1 {
+            let stale = !(7u8 << (3 * ((k + 1) % 2)));
+            let [nx, ny, _] = self.grid.dims;
+            let spans = &self.grid.case_spans[((k - 1) % 3) * ny..][..ny - 1];
+            for (row, &span) in self.out.merged.chunks_exact_mut(nx).zip(spans) {
+                let (lo, hi) = lo_hi(span);
+                if lo < hi {
+                    row[lo..hi].iter_mut().for_each(|m| *m &= stale);
+                }
+            }
+        }
         // Each vertex pass in two copies, with and without normals: in one copy the normals'
         // per-row state took registers from the other's scan.
         if self.params.normals {
