@@ -58,8 +58,6 @@ struct Around {
     plane: usize,
     /// The first cube's layer.
     k: usize,
-    /// The first cube's parity class.
-    class: usize,
 }
 
 /// What the vertex and triangle passes read: classified slices, cube cases and row spans. Kept

@@ -1,7 +1,7 @@
 //! Step 4's decisions for the grey edges of one plane (SPEC §5), from layers of cube cases and
-//! planes of classified samples looked up once per plane. Per edge, `Grid::decide` had looked
-//! them up by their `z` (a division by 3 or 4 each), sliced rows with their bounds tests and
-//! tested which mode it ran in.
+//! planes of classified samples looked up once per plane. Looked up per edge, by the edge's `z`,
+//! they cost a division by 3 or 4 and a row's bounds tests each, and every grey edge of Steps 1–3
+//! paid a test of the mode.
 
 use super::{Around, Decision, Grid};
 use crate::Mode;
@@ -72,10 +72,10 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
         }
         let (i, j) = (x - usize::from(AXIS != 0), y - usize::from(AXIS != 1));
         let at = j * nx + i;
+        let class = self.class ^ (i & 1) ^ (j & 1) << 1;
         let around = Around {
             plane: at,
             k: self.k,
-            class: self.class ^ (i & 1) ^ (j & 1) << 1,
         };
         if self.grid.mode == Mode::Paper {
             return Decision::Merge(around);
@@ -89,7 +89,7 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
                 .is_some_and(|cubes| {
                     (0..4).all(|c| {
                         let (i, j, k) = cubes[c];
-                        self.grid.class_of((i, j, k)) == around.class ^ FLIPS[AXIS][c]
+                        self.grid.class_of((i, j, k)) == class ^ FLIPS[AXIS][c]
                             && self.grid.case_at(i, j, k) == cases[c]
                     })
                 })
@@ -98,7 +98,7 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
         // on the data.
         let mut all = 1;
         for (case, flip) in cases.into_iter().zip(FLIPS[AXIS]) {
-            let class = (around.class ^ flip) & 7;
+            let class = (class ^ flip) & 7;
             all &= self.grid.mergeable[class * 256 + usize::from(case)] >> AXIS;
         }
         if all & 1 == 1 && !self.pinch(x, y) {
