@@ -298,7 +298,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let (x_greys, y_greys) = (Greys::<0>::new(grid, n), Greys::<1>::new(grid, n));
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
-        let [px, py, pz] = grid.offset.map(|o| o & 1);
         let spans = grid.plane_spans(n);
         for y in 0..ny {
             let (lo, hi) = lo_hi(spans[y]);
@@ -314,13 +313,13 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             }
             let row = grid.padded_row(n, y);
             let values = &samples[y * nx..][..nx];
-            let x_grey = (y ^ py) & 1 == 1 && (n ^ pz) & 1 == 1;
-            let at = RowContext::new(grid, params, &field, x_greys.as_ref(), y, n, NORMALS);
+            let greys = x_greys.as_ref().and_then(|greys| greys.in_row(y));
+            let at = RowContext::new(grid, params, &field, greys, y, n, NORMALS);
             EdgeRow::new(values, &values[1..], &mut ids[xbase + y * nx..][..nx]).scan(
                 (row, &row[1..]),
                 lo,
                 hi,
-                |x, ends| out.edge_vertex::<T, 0, NORMALS>(&at, [x, y, n], x_grey, ends, sink),
+                |x, ends| out.edge_vertex::<T, 0, NORMALS>(&at, [x, y, n], ends, sink),
             )?;
             if y + 1 < ny {
                 let next = grid.padded_row(n, y + 1);
@@ -328,8 +327,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 let at = RowContext::new(grid, params, &field, y_greys.as_ref(), y, n, NORMALS);
                 let mut edges = EdgeRow::new(values, next_values, &mut ids[ybase + y * nx..][..nx]);
                 edges.scan((row, next), start, end, |x, ends| {
-                    let grey = (x ^ px) & 1 == 1 && (n ^ pz) & 1 == 0;
-                    out.edge_vertex::<T, 1, NORMALS>(&at, [x, y, n], grey, ends, sink)
+                    out.edge_vertex::<T, 1, NORMALS>(&at, [x, y, n], ends, sink)
                 })?;
             }
         }
@@ -351,7 +349,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
         let greys = Greys::<2>::new(grid, k);
         let zbase = 4 * nx * ny;
-        let [px, py, _] = grid.offset.map(|o| o & 1);
         let (below, above) = (grid.plane_spans(k), grid.plane_spans(k + 1));
         for y in 0..ny {
             let (start, end) = union_span([below[y], above[y]], nx);
@@ -361,11 +358,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             }
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
-            let at = RowContext::new(grid, params, &field, greys.as_ref(), y, k, NORMALS);
+            let row_greys = greys.as_ref().and_then(|greys| greys.in_row(y));
+            let at = RowContext::new(grid, params, &field, row_greys, y, k, NORMALS);
             let mut edges = EdgeRow::new(lower, upper, &mut ids[zbase + y * nx..][..nx]);
             edges.scan((below, above), start, end, |x, ends| {
-                let grey = (x ^ px) & 1 == 0 && (y ^ py) & 1 == 0;
-                out.edge_vertex::<T, 2, NORMALS>(&at, [x, y, k], grey, ends, sink)
+                out.edge_vertex::<T, 2, NORMALS>(&at, [x, y, k], ends, sink)
             })?;
         }
         Ok(())
@@ -468,7 +465,7 @@ struct RowContext<'a, 'v, T, const AXIS: usize> {
     field: &'a Field<'v, T>,
     /// For normals, the row's unchecked view of the field.
     normals: Option<InteriorRow<'a, 'v, T, AXIS>>,
-    /// For Step 4, the plane's grey edges.
+    /// For Step 4, the plane's grey edges if the row has any.
     greys: Option<&'a Greys<'a, AXIS>>,
     /// The row's y and z in world units, in lanes 1 and 2 (lane 0 is unused): the coordinates its
     /// vertices share except along their edge's axis, computed once per row as [`send`] would
@@ -542,7 +539,6 @@ impl Out<'_> {
         &mut self,
         row: &RowContext<'_, '_, T, AXIS>,
         p: [usize; 3],
-        grey: bool,
         (a, b): (T, T),
         sink: &mut impl Sink,
     ) -> Result<u32, Error> {
@@ -556,7 +552,9 @@ impl Out<'_> {
         self.stats.v13 += u64::from(counted);
         // Only a grey edge has a decision to count: three in four occupied edges skip it. Where
         // the row has no `greys`, each would be kept.
-        if grey && let Some(greys) = &row.greys {
+        if let Some(greys) = row.greys
+            && greys.is_grey(p[0])
+        {
             let mut decision = greys.decide(p[0], p[1]);
             let mut bounded = false;
             if let Decision::Merge(_) = decision

@@ -1,7 +1,8 @@
 //! Step 4's decisions for the grey edges of one plane (SPEC §5), from layers of cube cases and
 //! planes of classified samples looked up once per plane. Looked up per edge, by the edge's `z`,
 //! they cost a division by 3 or 4 and a row's bounds tests each, and every grey edge of Steps 1–3
-//! paid a test of the mode.
+//! paid a test of the mode. Which planes and rows hold grey edges is settled here too, so that
+//! a vertex pass tests only an edge's `x`, and Steps 1–3 test nothing.
 
 use super::{Around, Decision, Grid};
 use crate::Mode;
@@ -18,6 +19,11 @@ pub(super) struct Greys<'g, const AXIS: usize> {
     /// The first cube's layer, and its parity class at `i = j = 0`.
     k: usize,
     class: usize,
+    /// Which rows and which `x` in them have grey edges: those with `y & 1 == parity[1]` and `x & 1
+    /// == parity[0]` (x-edges: any `x`; y-edges: any row).
+    parity: [usize; 2],
+    paper: bool,
+    mergeable: &'static [u8; 2048],
     /// For SPEC §5 (b), classified samples: plane `z`, then planes `z − 1` and `z + 1` (z-edges
     /// inside the grid only, else empty).
     filled: [&'g [u8]; 3],
@@ -28,11 +34,19 @@ const FLIPS: [[usize; 4]; 3] = [[0, 2, 4, 6], [0, 1, 4, 5], [0, 1, 2, 3]];
 
 impl<'g, const AXIS: usize> Greys<'g, AXIS> {
     /// The grey edges of plane (or layer) `z`, if Step 4 may merge any of them: not in Steps
-    /// 1–3, nor where `z` puts the cubes around them outside the grid.
+    /// 1–3, nor in a plane without greys along `AXIS`, nor where `z` puts the cubes around them
+    /// outside the grid.
     pub fn new(grid: &'g Grid<'g>, z: usize) -> Option<Self> {
         let [nx, ny, nz] = grid.dims;
         let inside = |c: usize, n: usize| c >= 1 && c + 1 < n;
-        if grid.mode == Mode::Steps123 || (AXIS != 2 && !inside(z, nz)) {
+        let [px, py, pz] = grid.offset.map(|o| o & 1);
+        // x-greys lie in odd planes, y-greys in even ones (global indices).
+        let greys = match AXIS {
+            0 => (z ^ pz) & 1 == 1,
+            1 => (z ^ pz) & 1 == 0,
+            _ => true,
+        };
+        if grid.mode == Mode::Steps123 || !greys || (AXIS != 2 && !inside(z, nz)) {
             return None;
         }
         let plane = nx * ny;
@@ -53,11 +67,32 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
             cases,
             k,
             class: grid.class_of((0, 0, k)),
+            // x-greys lie in odd rows, z-greys in even rows and columns, y-greys in odd columns.
+            parity: match AXIS {
+                0 => [0, py ^ 1],
+                1 => [px ^ 1, 0],
+                _ => [px, py],
+            },
+            paper: grid.mode == Mode::Paper,
+            mergeable: grid.mergeable,
             filled: [filled(z), below, above],
         })
     }
 
-    /// Step 4's decision for the occupied grey edge from `(x, y)` in the plane.
+    /// The plane's grey edges if row `y` has any.
+    #[inline(always)]
+    pub fn in_row(&self, y: usize) -> Option<&Self> {
+        (AXIS == 1 || y & 1 == self.parity[1]).then_some(self)
+    }
+
+    /// Whether the edge from `x` of a row [`Greys::in_row`] gave is grey.
+    #[inline(always)]
+    pub fn is_grey(&self, x: usize) -> bool {
+        AXIS == 0 || x & 1 == self.parity[0]
+    }
+
+    /// Step 4's decision for the occupied grey edge from `(x, y)` in a row [`Greys::in_row`]
+    /// gave.
     #[inline(always)]
     pub fn decide(&self, x: usize, y: usize) -> Decision {
         let [nx, ny, _] = self.grid.dims;
@@ -77,7 +112,7 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
             plane: at,
             k: self.k,
         };
-        if self.grid.mode == Mode::Paper {
+        if self.paper {
             return Decision::Merge(around);
         }
         let s = if AXIS == 0 { nx } else { 1 };
@@ -99,7 +134,7 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
         let mut all = 1;
         for (case, flip) in cases.into_iter().zip(FLIPS[AXIS]) {
             let class = (class ^ flip) & 7;
-            all &= self.grid.mergeable[class * 256 + usize::from(case)] >> AXIS;
+            all &= self.mergeable[class * 256 + usize::from(case)] >> AXIS;
         }
         if all & 1 == 1 && !self.pinch(x, y) {
             Decision::Merge(around)
