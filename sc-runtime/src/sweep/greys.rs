@@ -4,7 +4,7 @@
 //! paid a test of the mode. Which planes and rows hold grey edges is settled here too, so that
 //! a vertex pass tests only an edge's `x`, and Steps 1–3 test nothing.
 
-use super::{Around, Decision, Grid};
+use super::{Decision, Grid};
 use crate::Mode;
 
 /// The grey edges along `AXIS` of plane `z` (for z-edges, of layer `z`) whose four cubes lie
@@ -27,6 +27,32 @@ pub(super) struct Greys<'g, const AXIS: usize> {
     /// For SPEC §5 (b), classified samples: plane `z`, then planes `z − 1` and `z + 1` (z-edges
     /// inside the grid only, else empty).
     filled: [&'g [u8]; 3],
+}
+
+/// The four cubes around an interior grey edge, by the first of them (see
+/// `Grid::cubes_around`); the others follow it at fixed steps, one along each of the two axes
+/// across the edge. Made only by [`Greys::decide`], for an edge it found interior: the merge
+/// marks (`Out::mark_merged`) rely on that, unchecked.
+#[derive(Clone, Copy)]
+pub(super) struct Around {
+    plane: usize,
+    k: usize,
+}
+
+impl Around {
+    /// The first cube's index in a plane of cubes, `j · nx + i`. It is a cube of the grid (`i <
+    /// nx − 1`, `j < ny − 1`), so the index plus `nx + 1`, the furthest the other three lie, is
+    /// below `nx · ny`.
+    #[inline(always)]
+    pub fn plane(self) -> usize {
+        self.plane
+    }
+
+    /// The first cube's layer.
+    #[inline(always)]
+    pub fn k(self) -> usize {
+        self.k
+    }
 }
 
 /// How a cube's class differs from the first cube's, in [`Greys::cases`]' order.
@@ -97,9 +123,11 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
     pub fn decide(&self, x: usize, y: usize) -> Decision {
         let [nx, ny, _] = self.grid.dims;
         let inside = |c: usize, n: usize| c >= 1 && c + 1 < n;
+        // Interior across the edge, and the edge's upper end in the grid along it (which every
+        // occupied edge has; tested for the reads below).
         let interior = match AXIS {
-            0 => inside(y, ny),
-            1 => inside(x, nx),
+            0 => x + 1 < nx && inside(y, ny),
+            1 => inside(x, nx) && y + 1 < ny,
             _ => inside(x, nx) && inside(y, ny),
         };
         if !interior {
@@ -116,8 +144,18 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
             return Decision::Merge(around);
         }
         let s = if AXIS == 0 { nx } else { 1 };
+        let read = |layer: &[u8], at: usize| {
+            // SAFETY: the four cubes around an interior edge lie in the grid, so their cases
+            // `at` and `at + s` are within the layers `new` took, `nx · ny` long (for z-edges,
+            // the second one row on, `nx · (ny − 1)`): with the tests above, the last cube's
+            // index is at most `(ny − 2) · nx − 2` for z-edges, `(ny − 1) · nx − 2` otherwise.
+            // Read unchecked, with no panic branch to keep their operands live: 2–3 % of the
+            // sweep's instructions.
+            debug_assert!(at < layer.len());
+            unsafe { *layer.get_unchecked(at) }
+        };
         let [a, b] = self.cases;
-        let cases = [a[at], a[at + s], b[at], b[at + s]];
+        let cases = [read(a, at), read(a, at + s), read(b, at), read(b, at + s)];
         debug_assert!(
             self.grid
                 .cubes_around([x, y, self.z()], AXIS)
@@ -154,17 +192,23 @@ impl<'g, const AXIS: usize> Greys<'g, AXIS> {
             return false;
         }
         let p = y * nx + x;
-        let centre = here[p];
-        let faces = here[p - 1] != centre
-            && here[p + 1] != centre
-            && here[p - nx] != centre
-            && here[p + nx] != centre;
+        let at = |plane: &[u8], q: usize| {
+            // SAFETY: `p` is interior in its plane (tested above), so `p ± nx ± 1` are within
+            // the planes `new` took, `nx · ny` long (`below` and `above` too, being non-empty
+            // here). Unchecked as the cases in `decide`.
+            debug_assert!(q < plane.len());
+            unsafe { *plane.get_unchecked(q) }
+        };
+        let centre = at(here, p);
+        let faces = at(here, p - 1) != centre
+            && at(here, p + 1) != centre
+            && at(here, p - nx) != centre
+            && at(here, p + nx) != centre;
         let pinch = if AXIS == 2 {
-            faces && below[p] != centre && above[p] != centre
+            faces && at(below, p) != centre && at(above, p) != centre
         } else {
-            let diagonals =
-                here[p - nx - 1] & here[p - nx + 1] & here[p + nx - 1] & here[p + nx + 1];
-            faces && (centre == 1 || diagonals == 1)
+            let corners = [p - nx - 1, p - nx + 1, p + nx - 1, p + nx + 1];
+            faces && (centre == 1 || corners.into_iter().all(|q| at(here, q) == 1))
         };
         debug_assert_eq!(pinch, self.grid.pinch([x, y, self.z()], AXIS));
         pinch
