@@ -165,7 +165,6 @@ fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, 
         mergeable |= u8::from(g.mergeable) << axis;
     }
     let count = triangles.len() as u8;
-    let ear_axes = (0..3).fold(0u8, |m, axis| m | u8::from(ears[axis] != NO_EAR) << axis);
     let all = ((1u16 << count) - 1) as u8;
     let kept = (0..8u8).map(|merged| {
         (0..3)
@@ -173,10 +172,13 @@ fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, 
             .fold(all, |k, axis| k & !(1 << ears[axis]))
     });
     let mut merge = [0u8; 3];
+    let mut owned_ears = 0u8;
     for axis in 0..3 {
         if ears[axis] != NO_EAR {
-            merge[axis] = merge_byte(class, axis, tris[usize::from(ears[axis])])
+            let (byte, owner) = merge_byte(class, axis, tris[usize::from(ears[axis])])
                 .ok_or_else(|| format!("class {class}: the ear of grey axis {axis} does not cross the faces of its edge"))?;
+            merge[axis] = byte;
+            owned_ears |= u8::from(owner) << axis;
         }
     }
     let tris = tris.iter().map(|[a, b, c]| quote!([#a, #b, #c]));
@@ -186,7 +188,7 @@ fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, 
             count: #count,
             ears: [#(#ears),*],
             mergeable: #mergeable,
-            ear_axes: #ear_axes,
+            owned_ears: #owned_ears,
             kept: [#(#kept),*],
             merge: [#(#merge),*],
         }
@@ -198,8 +200,9 @@ fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, 
 /// grey edge, and one of those faces is shared with the merge partner, the neighbour along the
 /// pairing axis (y for x-greys, x for y-greys, y or x for z-greys in even or odd layers). The
 /// grey edge lies on the cube's high face there if the cube owns the pair, on its low face if it
-/// is the partner. `None` if the outer vertices do not lie one on each face.
-fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Option<u8> {
+/// is the partner. With the byte, whether the cube owns the pair. `None` if the outer vertices do
+/// not lie one on each face.
+fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Option<(u8, bool)> {
     let z_layer_odd = class >> 2 & 1 == 1;
     let pairing = if axis == 0 || axis == 2 && !z_layer_odd {
         1
@@ -220,10 +223,10 @@ fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Opti
     }
     Some(if side == 1 {
         // The owner: which of its outer vertices is the shared one.
-        if back_on { BACK_SHARED } else { 0 }
+        (if back_on { BACK_SHARED } else { 0 }, true)
     } else {
         // The partner: the outer vertex off the shared face.
-        if back_on { forward } else { back }
+        (if back_on { forward } else { back }, false)
     })
 }
 
@@ -283,6 +286,45 @@ mod tests {
                 && out.contains("include_bytes")
         );
         assert_eq!(out.matches("Entry {").count(), 4096);
+    }
+
+    /// Ownership is a property of a cube's class and the grey axis, and of the two cubes a merged
+    /// pair joins (neighbours along the pairing axis, whose classes differ in that axis's bit),
+    /// exactly one owns it: the triangle pass emits each merged triangle once.
+    #[test]
+    fn one_owner_per_merged_pair() {
+        let set = committed();
+        let mut owner: [[Option<bool>; 3]; 8] = [[None; 3]; 8];
+        for (class, entries) in set.classes.iter().enumerate() {
+            for entry in &entries.cases {
+                for g in &entry.grey {
+                    let Some(i) = g.ear else { continue };
+                    let mut ear = entry.triangles[usize::from(i)];
+                    while ear[1] != g.edge {
+                        ear.rotate_left(1);
+                    }
+                    let axis = usize::from(g.edge / 4);
+                    let (_, owns) = merge_byte(class, axis, ear).unwrap();
+                    let seen = owner[class][axis].get_or_insert(owns);
+                    assert_eq!(*seen, owns, "class {class} axis {axis}");
+                }
+            }
+        }
+        for class in 0..8 {
+            for axis in 0..3 {
+                let z_layer_odd = class >> 2 & 1 == 1;
+                let pairing_bit = if axis == 0 || axis == 2 && !z_layer_odd {
+                    2
+                } else {
+                    1
+                };
+                let pair = (owner[class][axis], owner[class ^ pairing_bit][axis]);
+                let (Some(a), Some(b)) = pair else {
+                    panic!("class {class} axis {axis}: no ear in the tables")
+                };
+                assert_ne!(a, b, "class {class} axis {axis}");
+            }
+        }
     }
 
     #[test]

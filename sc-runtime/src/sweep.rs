@@ -241,9 +241,11 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let (own_lo, own_hi) = self.grid.own_cubes[2];
         if (own_lo..own_hi).contains(&k) {
             if self.grid.mode == Mode::Steps123 {
-                self.triangles::<false>(k, sink);
+                self.triangles::<false, 0>(k, sink);
+            } else if k.is_multiple_of(2) {
+                self.triangles::<true, 0>(k, sink);
             } else {
-                self.triangles::<true>(k, sink);
+                self.triangles::<true, 3>(k, sink);
             }
         }
         if self.out.emit {
@@ -359,15 +361,17 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Steps 3 and 4: each cube's table triangles, with the ears of merged grey edges replaced
-    /// (`MERGING`, a constant so that Steps 1–3 get a copy without the merge marks).
+    /// (`MERGING`, a constant so that Steps 1–3 get a copy without the merge marks). `SHIFT` is
+    /// where layer `k`'s marks lie in their bytes, `3 · (k % 2)` (see [`Out::merged`]): a
+    /// constant, one copy per layer parity, as a shift by a variable cost the merging pass two
+    /// instructions per crossed cube.
     // Not inlined: each pass runs once per layer, and apart it shows in a profile.
     #[inline(never)]
-    fn triangles<const MERGING: bool>(&mut self, k: usize, sink: &mut impl Sink) {
+    fn triangles<const MERGING: bool, const SHIFT: u8>(&mut self, k: usize, sink: &mut impl Sink) {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
         let grid = &self.grid;
         let ids = CubeIds::new(self.ids, self.out.merged, grid.dims, k);
-        let shift = 3 * (k % 2);
         // Counted in locals, added to the stats once: stores to the stats on every cube could
         // not be moved past the loop's bounds checks.
         let (mut t13, mut triangles) = (0u64, 0u64);
@@ -399,9 +403,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                 // branches: which greys merged is data, and data-dependent branches mispredict.
                 let mut kept = entry.kept[0];
                 if MERGING {
-                    let marks = usize::from(cube.marks() >> shift & 7);
+                    let marks = usize::from(cube.marks() >> SHIFT & 7);
                     kept = entry.kept[marks];
-                    let mut owned = marks as u8 & entry.ear_axes & OWNS[class];
+                    let mut owned = marks as u8 & entry.owned_ears;
                     while owned != 0 {
                         let axis = owned.trailing_zeros() as usize;
                         owned &= owned - 1;
@@ -428,24 +432,6 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         self.out.stats.triangles += triangles;
     }
 }
-
-/// Per class, bit `axis` set iff a cube of the class owns the merged pair of that grey edge: it
-/// emits the pair's triangle, its partner (the neighbour across the pair's shared face) does not.
-/// x-greys pair with the y-neighbour and y-greys with the x-neighbour, so the diagonal is
-/// horizontal; z-greys pair along y in even layers and along x in odd ones, so the quads above and
-/// below a sample choose different diagonals. The owner is the lower cube of the pair.
-const OWNS: [u8; 8] = {
-    let mut owns = [0u8; 8];
-    let mut p = 0;
-    while p < 8 {
-        let (a, b, c) = (p & 1, (p >> 1) & 1, (p >> 2) & 1);
-        // The grey edge lies on the high side of the cube along the pairing axis.
-        let z_owner = if c == 0 { b == 1 } else { a == 1 };
-        owns[p] = (b == 0) as u8 | ((a == 0) as u8) << 1 | (z_owner as u8) << 2;
-        p += 1;
-    }
-    owns
-};
 
 /// What a vertex pass hands [`Out::edge_vertex`] for every edge along `AXIS` of a row.
 struct RowContext<'a, 'v, T, const AXIS: usize> {
@@ -797,7 +783,7 @@ impl Grid<'_> {
     }
 
     /// Per grey-edge axis, where a merged pair's partner is from its owner in layer `k` (see
-    /// [`OWNS`]): its distance in a plane of cubes, and the parity bit that differs.
+    /// [`Entry::owned_ears`]): its distance in a plane of cubes, and the parity bit that differs.
     fn partners(&self, k: usize) -> [(usize, usize); 3] {
         let (along_x, along_y) = ((1, 1), (self.dims[0], 2));
         let z = if (k + self.offset[2]).is_multiple_of(2) {
@@ -808,7 +794,7 @@ impl Grid<'_> {
         [along_y, along_x, z]
     }
 
-    /// For a merged grey edge owned by this cube (see [`OWNS`]): the triangle that replaces its
+    /// For a merged grey edge owned by this cube (see [`Entry::owned_ears`]): the triangle that replaces its
     /// ear and its partner's. The cube's case is `cases[0]`; its partner is `step` further on in
     /// the cases and the ids, with its class `flip`ped ([`Grid::partners`]).
     #[inline(always)]

@@ -21,8 +21,14 @@ pub struct Entry {
     pub ears: [u8; 3],
     /// Bit `axis` set iff that grey edge is occupied and mergeable.
     pub mergeable: u8,
-    /// Bit `axis` set iff `ears[axis]` is not [`NO_EAR`].
-    pub ear_axes: u8,
+    /// Bit `axis` set iff `ears[axis]` is not [`NO_EAR`] and the cube owns that grey edge's merged
+    /// pair: it emits the pair's triangle, and its partner, the neighbour across the face the two
+    /// ears share, emits nothing. x-greys pair with the y-neighbour and y-greys with the
+    /// x-neighbour, so the diagonal is horizontal; z-greys pair along y in even layers and along
+    /// x in odd ones, so the quads above and below a sample choose different diagonals. The owner
+    /// is the lower cube of the pair. Derived when the tables are included, so that Step 4 tests
+    /// ownership with the entry it has already read.
+    pub owned_ears: u8,
     /// Indexed by a set of merged grey axes (bit `axis`): bit `n` set iff triangle `n` is
     /// kept, that is, it is one of the first `count` and not the ear of a merged axis. Derived
     /// from `count` and `ears` when the tables are included, so that Step 4's per-cube
