@@ -310,15 +310,15 @@ mod tests {
                 }
             }
         }
-        for class in 0..8 {
-            for axis in 0..3 {
+        for (class, axes) in owner.iter().enumerate() {
+            for (axis, &owns) in axes.iter().enumerate() {
                 let z_layer_odd = class >> 2 & 1 == 1;
                 let pairing_bit = if axis == 0 || axis == 2 && !z_layer_odd {
                     2
                 } else {
                     1
                 };
-                let pair = (owner[class][axis], owner[class ^ pairing_bit][axis]);
+                let pair = (owns, owner[class ^ pairing_bit][axis]);
                 let (Some(a), Some(b)) = pair else {
                     panic!("class {class} axis {axis}: no ear in the tables")
                 };
