@@ -157,9 +157,7 @@ fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, 
         let axis = usize::from(g.edge / 4);
         if let Some(i) = g.ear {
             let t = &mut tris[usize::from(i)];
-            while t[1] != g.edge {
-                t.rotate_left(1);
-            }
+            *t = ear(*t, g.edge);
             ears[axis] = i;
         }
         mergeable |= u8::from(g.mergeable) << axis;
@@ -203,14 +201,8 @@ fn packed(class: usize, triangles: &[[u8; 3]], grey: &[Grey]) -> Result<Tokens, 
 /// is the partner. With the byte, whether the cube owns the pair. `None` if the outer vertices do
 /// not lie one on each face.
 fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Option<(u8, bool)> {
-    let z_layer_odd = class >> 2 & 1 == 1;
-    let pairing = if axis == 0 || axis == 2 && !z_layer_odd {
-        1
-    } else {
-        0
-    };
     let face = |side: u8| Face {
-        axis: pairing,
+        axis: pairing(class, axis),
         side,
     };
     let side = u8::from(face(1).contains_edge(grey));
@@ -228,6 +220,25 @@ fn merge_byte(class: usize, axis: usize, [back, grey, forward]: [u8; 3]) -> Opti
         // The partner: the outer vertex off the shared face.
         (if back_on { forward } else { back }, false)
     })
+}
+
+/// The ear triangle `t` of grey edge `grey` rotated to `[back, grey, forward]`.
+fn ear(mut t: [u8; 3], grey: u8) -> [u8; 3] {
+    while t[1] != grey {
+        t.rotate_left(1);
+    }
+    t
+}
+
+/// The axis along which a cube of class `class` pairs with its merge partner for the grey edge
+/// along `axis`: y for x-greys, x for y-greys, y or x for z-greys in even or odd layers.
+fn pairing(class: usize, axis: usize) -> usize {
+    let z_layer_odd = class >> 2 & 1 == 1;
+    if axis == 0 || axis == 2 && !z_layer_odd {
+        1
+    } else {
+        0
+    }
 }
 
 /// Mirrors `sc_runtime::tables::NO_EAR` (the macro cannot depend on the runtime it feeds).
@@ -299,11 +310,8 @@ mod tests {
             for entry in &entries.cases {
                 for g in &entry.grey {
                     let Some(i) = g.ear else { continue };
-                    let mut ear = entry.triangles[usize::from(i)];
-                    while ear[1] != g.edge {
-                        ear.rotate_left(1);
-                    }
                     let axis = usize::from(g.edge / 4);
+                    let ear = ear(entry.triangles[usize::from(i)], g.edge);
                     let (_, owns) = merge_byte(class, axis, ear).unwrap();
                     let seen = owner[class][axis].get_or_insert(owns);
                     assert_eq!(*seen, owns, "class {class} axis {axis}");
@@ -312,13 +320,9 @@ mod tests {
         }
         for (class, axes) in owner.iter().enumerate() {
             for (axis, &owns) in axes.iter().enumerate() {
-                let z_layer_odd = class >> 2 & 1 == 1;
-                let pairing_bit = if axis == 0 || axis == 2 && !z_layer_odd {
-                    2
-                } else {
-                    1
-                };
-                let pair = (owns, owner[class ^ pairing_bit][axis]);
+                // The partner's class differs in the pairing axis's parity bit.
+                let partner = class ^ 1 << pairing(class, axis);
+                let pair = (owns, owner[partner][axis]);
                 let (Some(a), Some(b)) = pair else {
                     panic!("class {class} axis {axis}: no ear in the tables")
                 };

@@ -22,6 +22,8 @@ pub(super) struct Greys<'g, const AXIS: usize> {
     /// Which rows and which `x` in them have grey edges: those with `y & 1 == parity[1]` and `x & 1
     /// == parity[0]` (x-edges: any `x`; y-edges: any row).
     parity: [usize; 2],
+    /// The grid's mode (Paper mode merges every interior grey) and mergeable bits, copied so a
+    /// decision reads them without going through the grid.
     paper: bool,
     mergeable: &'static [u8; 2048],
     /// For SPEC §5 (b), classified samples: plane `z`, then planes `z − 1` and `z + 1` (z-edges
