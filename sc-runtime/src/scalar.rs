@@ -1,3 +1,5 @@
+use wide::i32x4;
+
 /// A sample type the extractor reads.
 ///
 /// Classification (`filled`) is done in the sample's own type where that is exact, so integer
@@ -23,6 +25,12 @@ pub trait Scalar: Copy + Send + Sync + 'static {
     fn diff32(a: Self, b: Self) -> f32 {
         Self::diff(a, b) as f32
     }
+    /// Three [`Scalar::diff32`]s, `b[d] − a[d]`, and a zero: a gradient's lanes. Integer types
+    /// of up to 16 bits subtract in `i32` and convert the three at once.
+    #[inline]
+    fn diffs32(a: [Self; 3], b: [Self; 3]) -> [f32; 4] {
+        lane_by_lane(a, b)
+    }
     /// Step 1 over a row: `out[i]` is 1 where `row[i]` is filled, else 0. A type may override
     /// it to take per-row decisions out of the loop, so that the loop vectorises.
     #[inline]
@@ -31,6 +39,13 @@ pub trait Scalar: Copy + Send + Sync + 'static {
             *o = u8::from(v.filled(t));
         }
     }
+}
+
+/// [`Scalar::diffs32`] one [`Scalar::diff32`] at a time.
+#[inline(always)]
+fn lane_by_lane<T: Scalar>(a: [T; 3], b: [T; 3]) -> [f32; 4] {
+    let [x, y, z] = core::array::from_fn(|d| T::diff32(a[d], b[d]));
+    [x, y, z, 0.0]
 }
 
 macro_rules! int_scalar {
@@ -60,6 +75,20 @@ macro_rules! int_scalar {
             #[inline]
             fn diff32(a: $t, b: $t) -> f32 {
                 (<$wide>::from(b) - <$wide>::from(a)) as f32
+            }
+            /// One vector conversion for the three lanes where `i32` holds the samples (the
+            /// test is on the type, decided when compiling): six scalar conversions and the
+            /// shuffles that packed their results were a tenth of what a vertex's normal cost.
+            #[inline]
+            fn diffs32(a: [$t; 3], b: [$t; 3]) -> [f32; 4] {
+                if size_of::<$t>() <= 2 {
+                    // Exact: samples of up to 16 bits are `i32`s, their differences too, and
+                    // those are `f32`s (below 2^24).
+                    let d = |k: usize| b[k] as i32 - a[k] as i32;
+                    i32x4::new([d(0), d(1), d(2), 0]).round_float().to_array()
+                } else {
+                    lane_by_lane(a, b)
+                }
             }
             #[inline]
             fn classify_row(row: &[$t], t: Option<$t>, out: &mut [u8]) {
