@@ -193,8 +193,8 @@ fn in_pool<R: Send>(pool: Option<&rayon::ThreadPool>, job: impl FnOnce() -> R + 
 /// when chunks would get fewer than [`MIN_CHUNK_LAYERS`]. Two per thread had balanced uneven
 /// surfaces when each sampled slice stood for the slices after it; with the estimate
 /// interpolated, they no longer finish apart, and every chunk after the first is moved when the
-/// output is joined and re-reads a plane at its seam: one per thread took 0.93–1.00× the time of
-/// two (`time_extract --threads 2`, two runs of alternating rounds on seven volumes).
+/// output is joined and re-reads a plane at its seam: one per thread took 0.87–1.00× the time of
+/// two (`time_extract --threads 2`, two runs of alternating rounds on six volumes).
 fn chunk_count(layers: usize, workers: usize) -> usize {
     layers.div_ceil(MIN_CHUNK_LAYERS).clamp(1, workers)
 }
@@ -256,8 +256,9 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
         triangles: t,
         ..
     } = out;
-    // SAFETY: each list is the finished stretches of that vector, all of them, in order (one
-    // part per stretch, as `extract_par` made them), and nothing touched the vectors since.
+    // SAFETY (both sides): each list is the finished stretches of its vector, all of them, in
+    // order (one part per stretch, as `extract_par` made them), and nothing touched the vectors
+    // since; the two sides join different vectors.
     rayon::join(
         || unsafe {
             region::join(p, &positions, |_, _| {});

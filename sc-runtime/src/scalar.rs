@@ -77,8 +77,9 @@ macro_rules! int_scalar {
                 (<$wide>::from(b) - <$wide>::from(a)) as f32
             }
             /// One vector conversion for the three lanes where `i32` holds the samples (the
-            /// test is on the type, decided when compiling): six scalar conversions and the
-            /// shuffles that packed their results were a tenth of what a vertex's normal cost.
+            /// test is on the type, decided when compiling): the three scalar conversions per
+            /// gradient and the shuffles that packed their results cost a vertex's normal about
+            /// 8 instructions more than this (`bench/profile.sh … --normals`).
             #[inline]
             fn diffs32(a: [$t; 3], b: [$t; 3]) -> [f32; 4] {
                 if size_of::<$t>() <= 2 {

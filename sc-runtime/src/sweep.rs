@@ -795,8 +795,8 @@ impl Grid<'_> {
     }
 
     /// For a merged grey edge owned by this cube (see [`Entry::owned_ears`]): the triangle that
-    /// replaces its ear and its partner's. The cube's case is `cases[0]`; its partner is `step` further on in
-    /// the cases and the ids, with its class `flip`ped ([`Grid::partners`]).
+    /// replaces its ear and its partner's. The cube's case is `cases[0]`; its partner is `step`
+    /// further on in the cases and the ids, with its class `flip`ped ([`Grid::partners`]).
     #[inline(always)]
     fn merged_triangle(
         &self,
