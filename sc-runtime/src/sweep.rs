@@ -17,7 +17,7 @@ use wide::u8x16;
 
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::{BACK_SHARED, Entry};
-use crate::vertex::{Field, InteriorRow, Steps, wide_crossing};
+use crate::vertex::{Field, InteriorPlane, InteriorRow, Steps, wide_crossing};
 
 mod bound;
 mod cube_ids;
@@ -288,6 +288,10 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let samples = src.slice(n);
         let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
         let (x_greys, y_greys) = (Greys::<0>::new(grid, n), Greys::<1>::new(grid, n));
+        let (x_plane, y_plane) = (
+            field.interior_plane::<0>(n, NORMALS),
+            field.interior_plane::<1>(n, NORMALS),
+        );
         let xbase = (n % 2) * 2 * nx * ny;
         let ybase = xbase + nx * ny;
         let spans = grid.plane_spans(n);
@@ -306,7 +310,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let row = grid.padded_row(n, y);
             let values = &samples[y * nx..][..nx];
             let greys = x_greys.as_ref().and_then(|greys| greys.in_row(y));
-            let at = RowContext::new(grid, params, &field, greys, y, n, NORMALS);
+            let at = RowContext::new(grid, params, &field, x_plane.as_ref(), greys, y, n);
             EdgeRow::new(values, &values[1..], &mut ids[xbase + y * nx..][..nx]).scan(
                 (row, &row[1..]),
                 lo,
@@ -316,7 +320,15 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             if y + 1 < ny {
                 let next = grid.padded_row(n, y + 1);
                 let next_values = &samples[(y + 1) * nx..][..nx];
-                let at = RowContext::new(grid, params, &field, y_greys.as_ref(), y, n, NORMALS);
+                let at = RowContext::new(
+                    grid,
+                    params,
+                    &field,
+                    y_plane.as_ref(),
+                    y_greys.as_ref(),
+                    y,
+                    n,
+                );
                 let mut edges = EdgeRow::new(values, next_values, &mut ids[ybase + y * nx..][..nx]);
                 edges.scan((row, next), start, end, |x, ends| {
                     out.edge_vertex::<T, 1, NORMALS>(&at, [x, y, n], ends, sink)
@@ -340,6 +352,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let (lower, upper) = (src.slice(k), src.slice(k + 1));
         let (grid, out, params, ids) = (&self.grid, &mut self.out, &self.params, &mut *self.ids);
         let greys = Greys::<2>::new(grid, k);
+        let plane = field.interior_plane::<2>(k, NORMALS);
         let zbase = 4 * nx * ny;
         let (below, above) = (grid.plane_spans(k), grid.plane_spans(k + 1));
         for y in 0..ny {
@@ -351,7 +364,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             let (below, above) = (grid.padded_row(k, y), grid.padded_row(k + 1, y));
             let (lower, upper) = (&lower[y * nx..][..nx], &upper[y * nx..][..nx]);
             let row_greys = greys.as_ref().and_then(|greys| greys.in_row(y));
-            let at = RowContext::new(grid, params, &field, row_greys, y, k, NORMALS);
+            let at = RowContext::new(grid, params, &field, plane.as_ref(), row_greys, y, k);
             let mut edges = EdgeRow::new(lower, upper, &mut ids[zbase + y * nx..][..nx]);
             edges.scan((below, above), start, end, |x, ends| {
                 out.edge_vertex::<T, 2, NORMALS>(&at, [x, y, k], ends, sink)
@@ -450,23 +463,23 @@ struct RowContext<'a, 'v, T, const AXIS: usize> {
 }
 
 impl<'a, 'v, T: Scalar, const AXIS: usize> RowContext<'a, 'v, T, AXIS> {
-    /// The context of row `y` of plane `z`.
+    /// The context of row `y` of plane `z`, whose rows for normals are `plane`'s.
     #[inline(always)]
     fn new(
         grid: &'a Grid<'a>,
         params: &'a Params,
         field: &'a Field<'v, T>,
+        plane: Option<&'a InteriorPlane<'v, T, AXIS>>,
         greys: Option<&'a Greys<'a, AXIS>>,
         y: usize,
         z: usize,
-        normals: bool,
     ) -> Self {
         let world = |d: usize, c: usize| world(params, d, (c + grid.offset[d]) as i64 as f64);
         RowContext {
             grid,
             params,
             field,
-            normals: field.interior_row::<AXIS>(y, z, normals),
+            normals: plane.and_then(|plane| plane.row(y)),
             greys,
             fixed: [0.0, world(1, y), world(2, z)],
         }
