@@ -261,23 +261,23 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
     // since; the two sides join different vectors.
     rayon::join(
         || unsafe {
-            region::join(p, &positions, |_, _| {});
-            region::join(n, &normals, |_, _| {});
-            region::join(v, &values, |_, _| {});
-            release_spare(p);
-            release_spare(n);
-            release_spare(v);
+            let written = region::join(p, &positions, |_, _| {});
+            release_spare(p, written);
+            let written = region::join(n, &normals, |_, _| {});
+            release_spare(n, written);
+            let written = region::join(v, &values, |_, _| {});
+            release_spare(v, written);
         },
         || unsafe {
             // The first part's shift is zero: it stays where it is, untouched.
-            region::join(t, &triangles, |i, t| {
+            let written = region::join(t, &triangles, |i, t| {
                 if shifts[i] != 0 {
                     t.as_flattened_mut()
                         .iter_mut()
                         .for_each(|v| *v += shifts[i]);
                 }
             });
-            release_spare(t);
+            release_spare(t, written);
         },
     );
     Ok(())

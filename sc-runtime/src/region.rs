@@ -86,7 +86,8 @@ pub(crate) fn stretches<'a, T>(buf: &'a mut Vec<T>, lens: &[usize]) -> Vec<Stret
 const BLOCK: usize = 2048;
 
 /// Makes `buf` the concatenation of `parts` in order, each part's elements passed to `adjust`
-/// with the part's index (in pieces, where they land).
+/// with the part's index (in pieces, where they land). Returns how far into `buf` the parts had
+/// been written (the end of the last written stretch), for [`release_spare`](crate::mesh).
 ///
 /// # Safety
 /// `parts` are the finished stretches of [`stretches`] on this `buf`, all of them, in order, and
@@ -95,7 +96,7 @@ pub(crate) unsafe fn join<T: Copy>(
     buf: &mut Vec<T>,
     parts: &[Filled<T>],
     adjust: impl Fn(usize, &mut [T]),
-) {
+) -> usize {
     let total: usize = parts.iter().map(|p| p.len + p.spill.len()).sum();
     if parts.iter().any(|p| !p.spill.is_empty()) {
         // Rare: copy everything into a vector of the right size.
@@ -109,8 +110,9 @@ pub(crate) unsafe fn join<T: Copy>(
             adjust(i, &mut joined[from..]);
         }
         *buf = joined;
-        return;
+        return total;
     }
+    let written = parts.iter().map(|p| p.start + p.len).max().unwrap_or(0);
     let base = buf.as_mut_ptr();
     let mut to = 0;
     for (i, p) in parts.iter().enumerate() {
@@ -136,6 +138,7 @@ pub(crate) unsafe fn join<T: Copy>(
     }
     // SAFETY: the first `total` elements are now the parts' elements, all initialised.
     unsafe { buf.set_len(total) };
+    written
 }
 
 #[cfg(test)]
@@ -145,7 +148,8 @@ mod tests {
 
     /// Parts that fit their stretches, and parts that overflow them (one of them a stretch of
     /// none), and parts of several blocks moved a little or a long way down (over themselves):
-    /// the vector is their concatenation, each mapped by its index.
+    /// the vector is their concatenation, each mapped by its index, and the join says how far
+    /// the stretches were written.
     #[test]
     fn joined_parts_are_concatenated_in_order() {
         let b = super::BLOCK;
@@ -170,12 +174,18 @@ mod tests {
             }
             let filled: Vec<_> = parts.into_iter().map(|p| p.finish()).collect();
             // SAFETY: all the stretches of `buf`, finished, in order.
-            unsafe {
+            let written = unsafe {
                 join(&mut buf, &filled, |i, xs| {
                     xs.iter_mut().for_each(|x| *x += i as u32)
                 })
             };
             assert_eq!(buf, want, "{lens:?} {counts:?}");
+            // Where every part fit, the end of the last stretch written into; else the joined
+            // copy, as long as the parts.
+            let fit = lens.iter().zip(&counts).all(|(l, c)| c <= l);
+            let ends = (0..3).map(|i| lens[..i].iter().sum::<usize>() + counts[i]);
+            let expected = if fit { ends.max().unwrap() } else { want.len() };
+            assert_eq!(written, expected, "{lens:?} {counts:?}");
         }
     }
 }
