@@ -1,12 +1,12 @@
 //! scikit-image's layout of a mesh, made in Rust: `marching_cubes` returns vertices and normals
 //! in the array's axis order, faces wound its way, and a value per vertex. Done in NumPy these
-//! were five temporary arrays and half the extraction's time again on small scans. Each pass left
-//! here is one the layout needs: the axes reversed for a C-ordered array, the winding turned for
-//! one of the two gradient directions.
+//! were five temporary arrays and half the extraction's time again on small scans. The sweep
+//! emits the coordinates in the array's order ([`Axes::Zyx`] for a C-ordered array), so the one
+//! pass left here is the winding, turned for one of the two gradient directions.
 
 use numpy::{PyArray1, PyUntypedArray};
 use pyo3::prelude::*;
-use sc_runtime::{Mesh, Params};
+use sc_runtime::{Axes, Mesh, Params};
 
 use crate::convert::{self, with_element};
 use crate::extract::{mode, run};
@@ -33,27 +33,22 @@ pub fn skimage_mesh<'py>(
         normals: true,
         values: true,
         spacing,
+        axes: if reverse_axes { Axes::Zyx } else { Axes::Xyz },
         ..Params::new(level)
     };
     let dims = convert::dims(volume, "volume")?;
     let mesh =
         with_element!(py, volume, "volume", T => run::<T>(py, volume, dims, &params, threads))?;
     let Mesh {
-        mut positions,
-        mut normals,
+        positions,
+        normals,
         values,
         mut triangles,
         ..
     } = mesh;
-    py.detach(|| {
-        if reverse_axes {
-            positions.iter_mut().for_each(|p| p.reverse());
-            normals.iter_mut().for_each(|n| n.reverse());
-        }
-        if flip_winding {
-            triangles.iter_mut().for_each(|t| t.swap(0, 2));
-        }
-    });
+    if flip_winding {
+        py.detach(|| triangles.iter_mut().for_each(|t| t.swap(0, 2)));
+    }
     // The faces go out as `uint32`; the caller views them as `int32` (no copy), which holds
     // every index: the runtime numbers vertices in `u32`, and a mesh of 2^31 vertices would
     // not fit in memory as `f32` triples.

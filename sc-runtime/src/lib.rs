@@ -22,7 +22,7 @@ mod scalar;
 pub mod tables;
 
 pub use error::Error;
-pub use params::{ErrorBound, Mode, Params, Volume};
+pub use params::{Axes, ErrorBound, Mode, Params, Volume};
 pub use scalar::Scalar;
 mod stats;
 pub use stats::Stats;

@@ -23,7 +23,7 @@ mod bound;
 mod cube_ids;
 mod edge_row;
 mod greys;
-use crate::{Error, Mode, Params, Scalar, Sink, Stats};
+use crate::{Axes, Error, Mode, Params, Scalar, Sink, Stats};
 use cube_ids::{Cube, CubeIds};
 use edge_row::EdgeRow;
 use greys::{Around, Greys};
@@ -615,11 +615,20 @@ fn send<T, const AXIS: usize>(
             _ => row.fixed[d],
         }
     });
-    sink.edge_vertex(global, AXIS, pos, normal);
+    match params.axes {
+        Axes::Xyz => sink.edge_vertex(global, AXIS, pos, normal),
+        Axes::Zyx => sink.edge_vertex(global, AXIS, reversed(pos), normal.map(reversed)),
+    }
     if params.values {
         // As NumPy's `maximum`: a NaN end gives NaN.
         sink.vertex_value((if a > b || a.is_nan() { a } else { b }) as f32);
     }
+}
+
+/// `[z, y, x]` from `[x, y, z]`, for [`Axes::Zyx`].
+#[inline(always)]
+fn reversed([x, y, z]: [f32; 3]) -> [f32; 3] {
+    [z, y, x]
 }
 
 impl Grid<'_> {

@@ -1,11 +1,12 @@
 //! Every entry point gives the same mesh, bit for bit: `extract_par` on 1, 2 and 8 threads,
 //! `SliceStreamer` fed one z-slice at a time, and allocation-free `extract_into` all equal
-//! `extract` (SPEC §7: output identical for any number of threads). Also the error paths: bad
+//! `extract` (SPEC §7: output identical for any number of threads), and `Axes::Zyx` gives it
+//! with its coordinates reversed. Also the error paths: bad
 //! input is an `Err`, never a panic or a wrap.
 
 use sc_runtime::{
-    Error, Mesh, Mode, Params, Scratch, SliceStreamer, Stats, Volume, demo, extract, extract_into,
-    extract_par,
+    Axes, Error, Mesh, Mode, Params, Scratch, SliceStreamer, Stats, Volume, demo, extract,
+    extract_into, extract_par,
 };
 use sc_tests::volumes::{self, Sample, Vol, brainsmall_crop, integer_noise, stent_crop};
 
@@ -60,6 +61,23 @@ fn all_entry_points_agree<T: Sample>(vol: &Vol<T>, what: &str) {
                     done.into_inner(),
                     vol.dims[2] - 1,
                     "progress counts every layer"
+                );
+            }
+            // Coordinates in `(z, y, x)` order: the same mesh, each position and normal
+            // reversed, on one thread and on two.
+            let zyx = Params {
+                axes: Axes::Zyx,
+                ..params
+            };
+            let mut want = base.clone();
+            for p in want.positions.iter_mut().chain(&mut want.normals) {
+                p.reverse();
+            }
+            for threads in [1, 2] {
+                let got = extract_par(&v, &zyx, threads, &|_| {}).expect("extract_par");
+                assert!(
+                    bits(&got) == bits(&want),
+                    "{what} {mode:?}: (z, y, x) on {threads} threads differs"
                 );
             }
             // Streaming, one slice at a time, through a four-slice ring.
