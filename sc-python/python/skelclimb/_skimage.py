@@ -113,8 +113,8 @@ def marching_cubes(
     # `>= level` in (x, y, z). Reversing the axes of a C-ordered array is a reflection, which
     # turns the winding round; scikit-image's 'descent' winds inward in the array's axes
     # (negative signed volume), 'ascent' outward. Its normals point down the gradient either
-    # way, as ours do. The reordering, the winding and the values are done natively, on the
-    # arrays the extraction made.
+    # way, as ours do. The sweep emits the coordinates in the array's order and the values as it
+    # places each vertex; the winding is turned natively, on the triangles the extraction made.
     c_order = volume.flags.c_contiguous
     axes = [2, 1, 0] if c_order else [0, 1, 2]
     xyz_spacing = tuple(spacing[a] * step_size for a in axes)
