@@ -19,8 +19,8 @@ pub enum Axes {
     #[default]
     Xyz,
     /// `(z, y, x)`: the axis order of a C-ordered NumPy array, whose first index is z. Emitted
-    /// so by the sweep, the coordinates need no pass that reverses them afterwards (the Python
-    /// package's `marching_cubes` spent 1.5–2 % of its call on one).
+    /// so by the sweep, the coordinates need no pass that reverses them afterwards: without
+    /// that pass the Python package's `marching_cubes` takes 0.91–0.97× the time.
     Zyx,
 }
 

