@@ -54,6 +54,8 @@ mod parallel;
 #[cfg(feature = "std")]
 pub use parallel::extract_par;
 #[cfg(feature = "std")]
+mod claims;
+#[cfg(feature = "std")]
 mod region;
 #[cfg(feature = "std")]
 mod spare;

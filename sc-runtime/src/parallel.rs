@@ -1,11 +1,13 @@
 use std::sync::Mutex;
+use std::time::Instant;
 use std::vec;
 use std::vec::Vec;
 
 use rayon::prelude::*;
 
+use crate::claims::{Claims, Progress};
 use crate::extract::{InMemory, has_cubes};
-use crate::mesh::{push_to_columns, release_spare};
+use crate::mesh::{OwnedScratch, push_to_columns, release_spare};
 use crate::region::{self, Filled, Stretch};
 use crate::spare::SPARES;
 use crate::survey::{self, Survey};
@@ -28,6 +30,24 @@ impl Sink for Region<'_> {
     push_to_columns!();
 }
 
+impl Region<'_> {
+    /// Cuts this region after its own room for the layers `next..end` still to come (as
+    /// [`extract_par`] sizes a chunk's, by the survey) and returns the rest: the room of the
+    /// tail from `end` on, which a thief takes over.
+    fn split_off(&mut self, survey: &Survey, next: usize, end: usize) -> Self {
+        let vertices = Mesh::room_for(survey.between(next, end + 1));
+        let keep = |len: usize| len + vertices;
+        Region {
+            positions: self.positions.split_off(keep(self.positions.len())),
+            normals: self.normals.split_off(keep(self.normals.len())),
+            values: self.values.split_off(keep(self.values.len())),
+            triangles: self
+                .triangles
+                .split_off(self.triangles.len() + Mesh::triangle_room(vertices)),
+        }
+    }
+}
+
 /// One chunk's output, with vertex ids local to the chunk. Ids below `first_plane` belong to the
 /// previous chunk's last plane, which this chunk numbered but did not emit.
 struct Part {
@@ -38,6 +58,8 @@ struct Part {
     vertices: usize,
     first_plane: u32,
     stats: Stats,
+    /// The part's first layer: parts are joined in this order.
+    z0: usize,
 }
 
 /// Extracts the surface on `threads` threads (0 = all cores). The z range is cut into chunks of
@@ -108,7 +130,8 @@ pub fn extract_par<T: Scalar>(
             })
             .collect(),
     );
-    let bounds = balanced_bounds(&survey, dims, chunks);
+    let work = layer_work(&survey, dims);
+    let bounds = balanced_bounds(&work, chunks);
     // One output, each chunk writing into its own stretch of it (see `region`), and scratch
     // from the spares: an extraction allocates what a one-thread one does. Both are taken here,
     // not on the workers: glibc gives each worker thread an arena of its own and returns what
@@ -143,41 +166,145 @@ pub fn extract_par<T: Scalar>(
     let scratches = (0..workers)
         .map(|_| SPARES.take(dims).map(Mutex::new))
         .collect::<Result<Vec<_>, _>>()?;
+    // Each chunk's worker claims its layers one by one, so that a worker done with its own can
+    // take over the tail of another's (see `claims`).
+    let claims: Vec<Claims<Region<'_>>> = bounds.iter().map(|&b| Claims::new(b)).collect();
     let run = || {
         bounds
             .par_iter()
             .zip(regions)
-            .map(|(&(z0, z1), mut region)| {
+            .enumerate()
+            .map(|(c, (&(z0, _), region))| {
                 // Each worker takes the scratch of its own index: the lock is never contended.
                 // A poisoned lock means a worker panicked, and that panic is on its way.
                 let slot = rayon::current_thread_index().unwrap_or(0) % scratches.len();
                 let mut scratch = scratches[slot].lock().unwrap_or_else(|p| p.into_inner());
-                let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
-                sweep.start(z0, &src, &mut region, z0 == 0)?;
-                let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
-                for k in z0..z1 {
-                    sweep.layer(k, &src, &mut region)?;
-                    progress(1);
+                let began = Instant::now();
+                // Where the worker's own layers ended: at `z1`, or where a thief cut them.
+                let mut own_end = z0;
+                let own = {
+                    let _worker = claims[c].begin();
+                    let own = &claims[c];
+                    sweep_part(
+                        &mut scratch,
+                        (&src, dims, params),
+                        z0,
+                        region,
+                        progress,
+                        |r| {
+                            let k = own.claim(|next, end| r.split_off(&survey, next, end));
+                            own_end = k.map_or(own_end, |k| k + 1);
+                            k
+                        },
+                    )?
+                };
+                let mut parts = vec![own];
+                let mut done = work[own_end] - work[z0];
+                while let Some((victim, (at, end))) = steal(
+                    &claims,
+                    &bounds,
+                    &work,
+                    (done, began.elapsed().as_secs_f64()),
+                ) {
+                    let Some(room) = claims[victim].take() else {
+                        break;
+                    };
+                    let mut layers = at..end;
+                    let src = (&src, dims, params);
+                    parts.push(sweep_part(&mut scratch, src, at, room, progress, |_| {
+                        layers.next()
+                    })?);
+                    done += work[end] - work[at];
                 }
-                Ok(Part {
-                    vertices: region.positions.len(),
-                    positions: region.positions.finish(),
-                    normals: region.normals.finish(),
-                    values: region.values.finish(),
-                    triangles: region.triangles.finish(),
-                    first_plane,
-                    stats: sweep.stats(),
-                })
+                Ok(parts)
             })
-            .collect::<Result<Vec<Part>, Error>>()
+            .collect::<Result<Vec<Vec<Part>>, Error>>()
     };
     let parts = in_pool(own_pool.as_ref(), run);
     for scratch in scratches {
         SPARES.give(scratch.into_inner().unwrap_or_else(|p| p.into_inner()));
     }
-    let parts = parts?;
+    let mut parts: Vec<Part> = parts?.into_iter().flatten().collect();
+    parts.sort_unstable_by_key(|p| p.z0);
     in_pool(own_pool.as_ref(), || stitch(&mut out, parts))?;
     Ok(out)
+}
+
+/// Sweeps the layers `next` hands out, from `z0` on, into `region`.
+fn sweep_part<'r, T: Scalar>(
+    scratch: &mut OwnedScratch,
+    (src, dims, params): (&InMemory<'_, T>, [usize; 3], &Params),
+    z0: usize,
+    mut region: Region<'r>,
+    progress: &(dyn Fn(usize) + Sync),
+    mut next: impl FnMut(&mut Region<'r>) -> Option<usize>,
+) -> Result<Part, Error> {
+    let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
+    sweep.start(z0, src, &mut region, z0 == 0)?;
+    let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
+    while let Some(k) = next(&mut region) {
+        sweep.layer(k, src, &mut region)?;
+        progress(1);
+    }
+    Ok(Part {
+        vertices: region.positions.len(),
+        positions: region.positions.finish(),
+        normals: region.normals.finish(),
+        values: region.values.finish(),
+        triangles: region.triangles.finish(),
+        first_plane,
+        stats: sweep.stats(),
+        z0,
+    })
+}
+
+/// A tail to take over, for a worker that has done `work` in `seconds`: of the chunk with the
+/// most work left, cut where [`cut`] says. Returns the chunk and the tail's layers.
+fn steal<R>(
+    claims: &[Claims<R>],
+    bounds: &[(usize, usize)],
+    work: &[usize],
+    thief: (usize, f64),
+) -> Option<(usize, (usize, usize))> {
+    let (victim, _) = claims
+        .iter()
+        .enumerate()
+        .filter_map(|(c, claims)| claims.left().map(|(next, end)| (c, work[end] - work[next])))
+        .max_by_key(|&(_, left)| left)?;
+    let z0 = bounds[victim].0;
+    let tail = claims[victim].steal(|p| cut(work, z0, thief, &p))?;
+    Some((victim, tail))
+}
+
+/// A tail shorter than this is left to its chunk: taking it over costs a seam (the tail's first
+/// plane classified and numbered again), about a layer's work.
+const MIN_TAIL: usize = 2;
+
+/// Where a thief that did `work` in `seconds` cuts a chunk begun at layer `z0`: so that both
+/// finish together if each keeps the speed it has shown (half the work left, before the chunk's
+/// worker has claimed a layer). `None` if the tail would have fewer than [`MIN_TAIL`] layers.
+fn cut(work: &[usize], z0: usize, (did, seconds): (usize, f64), p: &Progress) -> Option<usize> {
+    // The worker keeps at least the layer after the one under way.
+    let from = p.next + 1;
+    if from + MIN_TAIL > p.end {
+        return None;
+    }
+    // Layer `next - 1` is under way, and counted as done: a worker that has not finished its
+    // first layer when the thief has finished a chunk is slow, but not as slow as nothing.
+    let done = work[p.next] - work[z0];
+    let left = (work[p.end] - work[p.next]) as f64;
+    let share = if done == 0 {
+        left / 2.0
+    } else {
+        let (thief, worker) = (did as f64 / seconds, done as f64 / p.seconds);
+        left * thief / (thief + worker)
+    };
+    if !share.is_finite() {
+        return None;
+    }
+    // The first layer from which the tail's work is at most the thief's share.
+    let at = from + work[from..p.end].partition_point(|&w| (work[p.end] - w) as f64 > share);
+    (at + MIN_TAIL <= p.end).then_some(at)
 }
 
 /// Runs `job` in `pool`, or in rayon's global pool (which has the threads asked for) when there
@@ -203,21 +330,30 @@ fn chunk_count(layers: usize, workers: usize) -> usize {
 /// cube's case, scanning its row): some hundred times more (`bench/profile.sh`).
 const VERTEX_WEIGHT: usize = 100;
 
-/// Cuts the z layers into `chunks` runs of about equal work: a layer's samples plus its
-/// surface, as the survey estimates it. Equal ranges of layers left one thread meshing the MNI
-/// brain's white matter band alone (a chunk with half the triangles), and two threads were no
-/// faster than one.
-fn balanced_bounds(survey: &Survey, dims: [usize; 3], chunks: usize) -> Vec<(usize, usize)> {
+/// The work of layers `0..k` for every `k` up to the layer count: a layer's samples plus its
+/// surface, as the survey estimates it.
+fn layer_work(survey: &Survey, dims: [usize; 3]) -> Vec<usize> {
     let [nx, ny, nz] = dims;
-    let layers = nz - 1;
-    let cost = |k: usize| nx * ny + VERTEX_WEIGHT * survey.at(k);
-    let total: usize = (0..layers).map(cost).sum();
+    let mut sum = 0;
+    core::iter::once(0)
+        .chain((0..nz - 1).map(|k| {
+            sum += nx * ny + VERTEX_WEIGHT * survey.at(k);
+            sum
+        }))
+        .collect()
+}
+
+/// Cuts the layers into `chunks` runs of about equal [`layer_work`]. Equal ranges of layers left
+/// one thread meshing the MNI brain's white matter band alone (a chunk with half the
+/// triangles), and two threads were no faster than one.
+fn balanced_bounds(work: &[usize], chunks: usize) -> Vec<(usize, usize)> {
+    let layers = work.len() - 1;
+    let total = work[layers];
     let mut bounds = Vec::with_capacity(chunks);
-    let (mut start, mut done) = (0, 0);
+    let mut start = 0;
     for k in 0..layers {
-        done += cost(k);
         // Chunk `c` ends at the first layer where the work so far reaches its share.
-        if done * chunks >= total * (bounds.len() + 1) && bounds.len() + 1 < chunks {
+        if work[k + 1] * chunks >= total * (bounds.len() + 1) && bounds.len() + 1 < chunks {
             bounds.push((start, k + 1));
             start = k + 1;
         }
@@ -285,12 +421,81 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
 
 #[cfg(test)]
 mod tests {
-    use super::{MIN_CHUNK_LAYERS, balanced_bounds, chunk_count};
-    use crate::Scalar;
+    use super::{MIN_CHUNK_LAYERS, MIN_TAIL, balanced_bounds, chunk_count, cut};
+    use crate::claims::Progress;
     use crate::extract::InMemory;
     use crate::survey::Survey;
+    use crate::{Mode, Params, Scalar, Volume, demo, extract, extract_par};
     use std::format;
+    use std::sync::OnceLock;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::thread::{self, ThreadId};
+    use std::time::Duration;
     use std::vec::Vec;
+
+    /// One thread sleeps after each of its layers, as a slow vCPU would be slow: the other
+    /// finishes its chunk and takes over most of the slow one's, and the mesh is still exactly
+    /// the one-thread mesh, in every mode, with and without normals.
+    #[test]
+    fn a_slow_thread_s_tail_is_taken_over() {
+        let v = demo::torus(40);
+        let vol = Volume::new(&v.data, v.dims).unwrap();
+        let layers = v.dims[2] - 1;
+        for mode in [Mode::Steps123, Mode::Paper, Mode::Embedded] {
+            for normals in [false, true] {
+                let params = Params {
+                    mode,
+                    normals,
+                    ..Params::new(v.iso)
+                };
+                // The first thread to finish a layer is the slow one.
+                let slow: OnceLock<ThreadId> = OnceLock::new();
+                let (slow_layers, all) = (AtomicUsize::new(0), AtomicUsize::new(0));
+                let progress = |n: usize| {
+                    all.fetch_add(n, Ordering::Relaxed);
+                    if *slow.get_or_init(|| thread::current().id()) == thread::current().id() {
+                        slow_layers.fetch_add(n, Ordering::Relaxed);
+                        thread::sleep(Duration::from_millis(5));
+                    }
+                };
+                let mesh = extract_par(&vol, &params, 2, &progress).unwrap();
+                assert_eq!(mesh, extract(&vol, &params).unwrap(), "{mode:?} {normals}");
+                assert_eq!(all.into_inner(), layers);
+                // Its own chunk was about half the layers.
+                let slow_layers = slow_layers.into_inner();
+                assert!(
+                    slow_layers <= layers / 4,
+                    "{slow_layers} of {layers} layers"
+                );
+            }
+        }
+    }
+
+    /// The cut gives the thief the share of the work left that its speed says: all layers of
+    /// equal work, a thief twice as fast as the chunk's worker takes two thirds; before the
+    /// worker has finished a layer, half; a tail of fewer than `MIN_TAIL` layers is not cut.
+    #[test]
+    fn cuts_share_the_work_by_speed() {
+        let work: Vec<usize> = (0..=40).map(|k| 10 * k).collect();
+        let at = |next: usize, end: usize, seconds: f64| Progress { next, end, seconds };
+        // The worker began at 10 and has done 10..16 (15 under way) in 1.2 seconds; the
+        // thief did 10 layers in a second, twice as fast. Of the 24 layers left it takes 16.
+        assert_eq!(cut(&work, 10, (100, 1.0), &at(16, 40, 1.2)), Some(24));
+        // No layer claimed: half of what is left.
+        assert_eq!(cut(&work, 10, (100, 1.0), &at(10, 30, 0.001)), Some(20));
+        // A first layer under way for a long time: the thief takes all but the next one.
+        assert_eq!(cut(&work, 10, (100, 0.001), &at(11, 30, 1.0)), Some(12));
+        // Equal speeds, 2 · MIN_TAIL layers left: cut in the middle.
+        let end = 20 + 2 * MIN_TAIL;
+        assert_eq!(
+            cut(&work, 0, (200, 1.0), &at(20, end, 1.0)),
+            Some(20 + MIN_TAIL)
+        );
+        // Too little left, or nothing.
+        let end = 20 + MIN_TAIL;
+        assert_eq!(cut(&work, 0, (200, 1.0), &at(20, end, 1.0)), None);
+        assert_eq!(cut(&work, 0, (200, 1.0), &at(30, 30, 1.0)), None);
+    }
 
     /// All of the surface lies in ten slices in the middle of 101: the chunks cover every layer
     /// once, in order, and most of them go to the band, where equal ranges of layers would give
@@ -310,7 +515,7 @@ mod tests {
             nxy: 32 * 32,
         };
         let survey = Survey::new(&src, dims, u8::threshold(0.5));
-        let bounds = balanced_bounds(&survey, dims, 4);
+        let bounds = balanced_bounds(&super::layer_work(&survey, dims), 4);
         assert_eq!(bounds.len(), 4);
         assert_eq!(bounds.first().map(|b| b.0), Some(0));
         assert_eq!(bounds.last().map(|b| b.1), Some(100));

@@ -41,6 +41,21 @@ impl<T> Stretch<'_, T> {
         self.len + self.spill.len()
     }
 
+    /// Cuts this stretch after its first `keep` slots (at least those written) and returns the
+    /// rest as a stretch of its own: the room for a tail of the chunk's layers that another
+    /// worker takes over. After the cut this one spills past `keep`.
+    pub fn split_off(&mut self, keep: usize) -> Self {
+        let keep = keep.clamp(self.len, self.slots.len());
+        let (head, tail) = core::mem::take(&mut self.slots).split_at_mut(keep);
+        self.slots = head;
+        Stretch {
+            start: self.start + keep,
+            slots: tail,
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+
     /// What the join needs, without the borrow of the vector.
     pub fn finish(self) -> Filled<T> {
         Filled {
