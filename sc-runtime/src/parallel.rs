@@ -392,9 +392,10 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
         triangles: t,
         ..
     } = out;
-    // SAFETY (both sides): each list is the finished stretches of its vector, all of them, in
-    // order (one part per stretch, as `extract_par` made them), and nothing touched the vectors
-    // since; the two sides join different vectors.
+    // SAFETY (both sides): each list is the finished stretches of its vector, all of them: the
+    // chunks' and the tails' split off them, in the order of their starts (the parts are sorted
+    // by first layer, and a tail's stretch is the end of its chunk's), and nothing touched the
+    // vectors since; the two sides join different vectors.
     rayon::join(
         || unsafe {
             let written = region::join(p, &positions, |_, _| {});

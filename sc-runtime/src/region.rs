@@ -105,8 +105,9 @@ const BLOCK: usize = 2048;
 /// been written (the end of the last written stretch), for [`release_spare`](crate::mesh).
 ///
 /// # Safety
-/// `parts` are the finished stretches of [`stretches`] on this `buf`, all of them, in order, and
-/// `buf` has not been touched since.
+/// `parts` are the finished stretches of [`stretches`] on this `buf` and those split off them
+/// ([`Stretch::split_off`]), all of them, in the order of their starts, and `buf` has not been
+/// touched since.
 pub(crate) unsafe fn join<T: Copy>(
     buf: &mut Vec<T>,
     parts: &[Filled<T>],
@@ -160,6 +161,33 @@ pub(crate) unsafe fn join<T: Copy>(
 mod tests {
     use super::{join, stretches};
     use alloc::vec::Vec;
+
+    /// A stretch split after its written part, into a head that spills past the cut and a tail
+    /// that another writer fills (and one split below what was written, which keeps that, and
+    /// one past its end, which leaves the tail no room): joined in the order of their starts,
+    /// they are the concatenation of what each got.
+    #[test]
+    fn split_stretches_join_in_order() {
+        for (keep, kept) in [(5, 5), (1, 3), (99, 10)] {
+            let mut buf: Vec<u32> = Vec::new();
+            let mut parts = stretches(&mut buf, &[10, 6]);
+            let mut second = parts.pop().unwrap();
+            let mut head = parts.pop().unwrap();
+            (0..3).for_each(|x| head.push(x));
+            let mut tail = head.split_off(keep);
+            // The head fills its room up to the cut, then spills; the tail has the rest.
+            (3..7).for_each(|x| head.push(x));
+            (100..104).for_each(|x| tail.push(x));
+            (200..202).for_each(|x| second.push(x));
+            assert_eq!(head.len(), 7);
+            let filled = [head.finish(), tail.finish(), second.finish()];
+            assert_eq!(filled[1].start, kept, "cut at {keep}");
+            // SAFETY: all the stretches of `buf` and the one split off, finished, in order.
+            unsafe { join(&mut buf, &filled, |_, _| {}) };
+            let want: Vec<u32> = (0..7).chain(100..104).chain(200..202).collect();
+            assert_eq!(buf, want, "cut at {keep}");
+        }
+    }
 
     /// Parts that fit their stretches, and parts that overflow them (one of them a stretch of
     /// none), and parts of several blocks moved a little or a long way down (over themselves):
