@@ -15,6 +15,8 @@ use std::time::Instant;
 
 /// One chunk's layers and the hand-over of its tail's room (`R`).
 pub(crate) struct Claims<R> {
+    /// The chunk's first layer.
+    start: usize,
     state: Mutex<State<R>>,
     handed: Condvar,
 }
@@ -42,7 +44,8 @@ enum Tail<R> {
 
 /// What a thief knows when it decides where to cut a chunk.
 pub(crate) struct Progress {
-    /// The next layer the chunk's worker will claim, and the chunk's end.
+    /// The chunk's first layer, the next layer its worker will claim, and the chunk's end.
+    pub start: usize,
     pub next: usize,
     pub end: usize,
     /// Seconds since the chunk's worker began.
@@ -53,6 +56,7 @@ impl<R> Claims<R> {
     /// The claims of layers `z0..z1`.
     pub fn new((z0, z1): (usize, usize)) -> Self {
         Claims {
+            start: z0,
             state: Mutex::new(State {
                 next: z0,
                 end: z1,
@@ -100,6 +104,7 @@ impl<R> Claims<R> {
             return None;
         }
         let at = cut(Progress {
+            start: self.start,
             next: s.next,
             end: s.end,
             seconds: began.elapsed().as_secs_f64(),

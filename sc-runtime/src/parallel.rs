@@ -200,12 +200,8 @@ pub fn extract_par<T: Scalar>(
                 };
                 let mut parts = vec![own];
                 let mut done = work[own_end] - work[z0];
-                while let Some((victim, (at, end))) = steal(
-                    &claims,
-                    &bounds,
-                    &work,
-                    (done, began.elapsed().as_secs_f64()),
-                ) {
+                let thief = |done| (done, began.elapsed().as_secs_f64());
+                while let Some((victim, (at, end))) = steal(&claims, &work, thief(done)) {
                     let Some(room) = claims[victim].take() else {
                         break;
                     };
@@ -262,7 +258,6 @@ fn sweep_part<'r, T: Scalar>(
 /// most work left, cut where [`cut`] says. Returns the chunk and the tail's layers.
 fn steal<R>(
     claims: &[Claims<R>],
-    bounds: &[(usize, usize)],
     work: &[usize],
     thief: (usize, f64),
 ) -> Option<(usize, (usize, usize))> {
@@ -271,8 +266,7 @@ fn steal<R>(
         .enumerate()
         .filter_map(|(c, claims)| claims.left().map(|(next, end)| (c, work[end] - work[next])))
         .max_by_key(|&(_, left)| left)?;
-    let z0 = bounds[victim].0;
-    let tail = claims[victim].steal(|p| cut(work, z0, thief, &p))?;
+    let tail = claims[victim].steal(|p| cut(work, thief, &p))?;
     Some((victim, tail))
 }
 
@@ -280,10 +274,10 @@ fn steal<R>(
 /// plane classified and numbered again), about a layer's work.
 const MIN_TAIL: usize = 2;
 
-/// Where a thief that did `work` in `seconds` cuts a chunk begun at layer `z0`: so that both
-/// finish together if each keeps the speed it has shown (half the work left, before the chunk's
-/// worker has claimed a layer). `None` if the tail would have fewer than [`MIN_TAIL`] layers.
-fn cut(work: &[usize], z0: usize, (did, seconds): (usize, f64), p: &Progress) -> Option<usize> {
+/// Where a thief that did `work` in `seconds` cuts a chunk: so that both finish together if each
+/// keeps the speed it has shown (half the work left, before the chunk's worker has claimed a
+/// layer). `None` if the tail would have fewer than [`MIN_TAIL`] layers.
+fn cut(work: &[usize], (did, seconds): (usize, f64), p: &Progress) -> Option<usize> {
     // The worker keeps at least the layer after the one under way.
     let from = p.next + 1;
     if from + MIN_TAIL > p.end {
@@ -291,7 +285,7 @@ fn cut(work: &[usize], z0: usize, (did, seconds): (usize, f64), p: &Progress) ->
     }
     // Layer `next - 1` is under way, and counted as done: a worker that has not finished its
     // first layer when the thief has finished a chunk is slow, but not as slow as nothing.
-    let done = work[p.next] - work[z0];
+    let done = work[p.next] - work[p.start];
     let left = (work[p.end] - work[p.next]) as f64;
     let share = if done == 0 {
         left / 2.0
@@ -474,28 +468,33 @@ mod tests {
 
     /// The cut gives the thief the share of the work left that its speed says: all layers of
     /// equal work, a thief twice as fast as the chunk's worker takes two thirds; before the
-    /// worker has finished a layer, half; a tail of fewer than `MIN_TAIL` layers is not cut.
+    /// worker has claimed a layer, half; a tail of fewer than `MIN_TAIL` layers is not cut.
     #[test]
     fn cuts_share_the_work_by_speed() {
         let work: Vec<usize> = (0..=40).map(|k| 10 * k).collect();
-        let at = |next: usize, end: usize, seconds: f64| Progress { next, end, seconds };
+        let at = |start: usize, next: usize, end: usize, seconds: f64| Progress {
+            start,
+            next,
+            end,
+            seconds,
+        };
         // The worker began at 10 and has done 10..16 (15 under way) in 1.2 seconds; the
         // thief did 10 layers in a second, twice as fast. Of the 24 layers left it takes 16.
-        assert_eq!(cut(&work, 10, (100, 1.0), &at(16, 40, 1.2)), Some(24));
+        assert_eq!(cut(&work, (100, 1.0), &at(10, 16, 40, 1.2)), Some(24));
         // No layer claimed: half of what is left.
-        assert_eq!(cut(&work, 10, (100, 1.0), &at(10, 30, 0.001)), Some(20));
+        assert_eq!(cut(&work, (100, 1.0), &at(10, 10, 30, 0.001)), Some(20));
         // A first layer under way for a long time: the thief takes all but the next one.
-        assert_eq!(cut(&work, 10, (100, 0.001), &at(11, 30, 1.0)), Some(12));
+        assert_eq!(cut(&work, (100, 0.001), &at(10, 11, 30, 1.0)), Some(12));
         // Equal speeds, 2 · MIN_TAIL layers left: cut in the middle.
         let end = 20 + 2 * MIN_TAIL;
         assert_eq!(
-            cut(&work, 0, (200, 1.0), &at(20, end, 1.0)),
+            cut(&work, (200, 1.0), &at(0, 20, end, 1.0)),
             Some(20 + MIN_TAIL)
         );
         // Too little left, or nothing.
         let end = 20 + MIN_TAIL;
-        assert_eq!(cut(&work, 0, (200, 1.0), &at(20, end, 1.0)), None);
-        assert_eq!(cut(&work, 0, (200, 1.0), &at(30, 30, 1.0)), None);
+        assert_eq!(cut(&work, (200, 1.0), &at(0, 20, end, 1.0)), None);
+        assert_eq!(cut(&work, (200, 1.0), &at(0, 30, 30, 1.0)), None);
     }
 
     /// All of the surface lies in ten slices in the middle of 101: the chunks cover every layer
