@@ -82,7 +82,34 @@ macro_rules! push_to_columns {
         fn triangle(&mut self, triangle: [u32; 3]) {
             self.triangles.push(triangle);
         }
+
+        #[inline]
+        fn cube_triangle_if(&mut self, _: [usize; 3], triangle: [u32; 3], keep: bool) {
+            use $crate::mesh::PushIf;
+            self.triangles.push_if(triangle, keep);
+        }
     };
+}
+
+/// A push that writes the value whenever there is room and counts it only if kept: no branch on
+/// `keep` (see [`Sink::cube_triangle_if`]).
+pub(crate) trait PushIf<T> {
+    fn push_if(&mut self, value: T, keep: bool);
+}
+
+impl<T> PushIf<T> for Vec<T> {
+    #[inline(always)]
+    fn push_if(&mut self, value: T, keep: bool) {
+        match self.spare_capacity_mut().first_mut() {
+            Some(slot) => {
+                slot.write(value);
+                // SAFETY: the slot past the length was just written, within the capacity.
+                unsafe { self.set_len(self.len() + usize::from(keep)) };
+            }
+            None if keep => self.push(value),
+            None => {}
+        }
+    }
 }
 #[cfg(feature = "std")]
 pub(crate) use push_to_columns;
@@ -130,6 +157,11 @@ impl Sink for Presized<'_> {
     #[inline]
     fn triangle(&mut self, triangle: [u32; 3]) {
         self.0.triangle(triangle);
+    }
+
+    #[inline]
+    fn cube_triangle_if(&mut self, cube: [usize; 3], triangle: [u32; 3], keep: bool) {
+        self.0.cube_triangle_if(cube, triangle, keep);
     }
 }
 

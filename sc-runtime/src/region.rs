@@ -13,7 +13,7 @@ use core::mem::MaybeUninit;
 
 #[cfg(doc)]
 use crate::Mesh;
-use crate::mesh::huge_pages;
+use crate::mesh::{PushIf, huge_pages};
 
 /// A chunk's stretch of a shared vector: pushes go to the stretch until it is full, then to a
 /// vector of the chunk's own (the survey fell short, which the join handles by copying).
@@ -62,6 +62,21 @@ impl<T> Stretch<'_, T> {
             start: self.start,
             len: self.len,
             spill: self.spill,
+        }
+    }
+}
+
+/// Into the stretch's next slot while it has one, else spilled if kept.
+impl<T> PushIf<T> for Stretch<'_, T> {
+    #[inline(always)]
+    fn push_if(&mut self, value: T, keep: bool) {
+        match self.slots.get_mut(self.len) {
+            Some(slot) => {
+                slot.write(value);
+                self.len += usize::from(keep);
+            }
+            None if keep => self.spill.push(value),
+            None => {}
         }
     }
 }
@@ -160,7 +175,32 @@ pub(crate) unsafe fn join<T: Copy>(
 #[cfg(test)]
 mod tests {
     use super::{join, stretches};
+    use crate::mesh::PushIf;
     use alloc::vec::Vec;
+
+    /// Conditional pushes, kept and dropped in turn, into stretches with no room, a little and
+    /// plenty, and into vectors with no spare capacity, a little and plenty: each holds exactly
+    /// the kept values, in order, the stretches spilling past their room.
+    #[test]
+    fn conditional_pushes_hold_what_is_kept() {
+        let values: Vec<(u32, bool)> = (0..9).map(|x| (x, x % 3 != 1)).collect();
+        let want: Vec<u32> = values.iter().filter(|v| v.1).map(|v| v.0).collect();
+        let mut buf = Vec::new();
+        let mut parts = stretches(&mut buf, &[0, 2, 20]);
+        for part in &mut parts {
+            values.iter().for_each(|&(x, keep)| part.push_if(x, keep));
+            assert_eq!(part.len(), want.len());
+        }
+        let filled: Vec<_> = parts.into_iter().map(|p| p.finish()).collect();
+        // SAFETY: all the stretches of `buf`, finished, in order.
+        unsafe { join(&mut buf, &filled, |_, _| {}) };
+        assert_eq!(buf, want.repeat(3));
+        for capacity in [0, 4, 20] {
+            let mut v = Vec::with_capacity(capacity);
+            values.iter().for_each(|&(x, keep)| v.push_if(x, keep));
+            assert_eq!(v, want, "capacity {capacity}");
+        }
+    }
 
     /// A stretch split after its written part, into a head that spills past the cut and a tail
     /// that another writer fills (and one split below what was written, which keeps that, and

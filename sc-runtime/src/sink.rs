@@ -34,6 +34,16 @@ pub trait Sink {
         let _ = cube;
         self.triangle(triangle);
     }
+    /// [`Sink::cube_triangle`] if `keep`. Whether a cube owns a merged triangle is data, so the
+    /// sweep makes the triangle either way and says whether it counts: a sink with room to
+    /// spare (the mesh's vectors) writes it and counts it only if kept, without a branch that
+    /// mispredicts. The default tests `keep`.
+    #[inline]
+    fn cube_triangle_if(&mut self, cube: [usize; 3], triangle: [u32; 3], keep: bool) {
+        if keep {
+            self.cube_triangle(cube, triangle);
+        }
+    }
     /// A hint, after each layer: about this many more vertices and triangles are to come
     /// (extrapolated from the layers so far). A sink that allocates can reserve once instead of
     /// growing by doubling; the default ignores it.
