@@ -12,7 +12,7 @@ the shared data and what bench/derive_volumes.py makes of it) at their suggested
 
     python3 -m venv target/bench-venv
     target/bench-venv/bin/pip install ./sc-python scikit-image PyMCubes zmesh vtk
-    SC_DATA_DIR=../shared/data target/bench-venv/bin/python bench/python_compare.py
+    SC_DATA_DIR=../shared/data target/bench-venv/bin/python bench/python_compare.py [--rounds 3]
 """
 import argparse
 import importlib.metadata
@@ -121,6 +121,9 @@ def timed(fn, vol, iso, repeat):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="passes over all the volumes; times are medians over the rounds, ratios "
+                         "the medians of each round's ratios, with their range")
     ap.add_argument("--only", nargs="*", default=[],
                     help="volume labels to run (prefixes, e.g. mni152-f32@190), to rerun rows")
     a = ap.parse_args()
@@ -129,21 +132,40 @@ def main():
         (l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")),
         platform.processor(),
     )
-    print(f"Machine: {cpu}, {os.cpu_count()} threads; one thread per mesher; median of {a.repeat}")
+    rounds = f", {a.rounds} rounds" if a.rounds > 1 else ""
+    print(f"Machine: {cpu}, {os.cpu_count()} threads; one thread per mesher; "
+          f"median of {a.repeat}{rounds}")
     print(f"scikit-image {skimage.__version__}, VTK {vtk.vtkVersion.GetVTKVersion()}, "
           f"zmesh {importlib.metadata.version('zmesh')}\n")
     names = list(PEERS)
+    chosen = [(label, vol, iso) for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR"))
+              if not a.only or any(label.startswith(o) for o in a.only)]
+    # Each round times every mesher on every volume, one after the other: the two sides of a
+    # ratio are seconds apart, and a drift of the machine's speed shows as a spread of the
+    # rounds' ratios rather than as one volume's outlier.
+    runs = {label: [] for label, _, _ in chosen}
+    for r in range(a.rounds):
+        for label, vol, iso in chosen:
+            if a.rounds > 1:
+                print(f"round {r + 1}/{a.rounds}: {label}", file=sys.stderr, flush=True)
+            runs[label].append({n: timed(PEERS[n], vol, iso, a.repeat) for n in names})
     print("| volume | " + " | ".join(f"{n} ms (triangles)" for n in names)
           + " | scikit-image / ours | ours / FE |")
     print("|---" * (len(names) + 3) + "|")
-    for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR")):
-        if a.only and not any(label.startswith(o) for o in a.only):
-            continue
-        row = {n: timed(PEERS[n], vol, iso, a.repeat) for n in names}
-        ours = row["skelclimb"][0]
-        cells = " | ".join(f"{t:.1f} ({f:,})" for t, f in row.values())
-        print(f"| {label} | {cells} | {row['scikit-image'][0] / ours:.1f}× "
-              f"| {ours / row['VTK Flying Edges'][0]:.2f}× |", flush=True)
+
+    def ratio(values, digits):
+        mid = f"{statistics.median(values):.{digits}f}×"
+        if len(values) == 1:
+            return mid
+        return f"{mid} ({min(values):.{digits}f}–{max(values):.{digits}f})"
+
+    for label, rows in runs.items():
+        cells = " | ".join(
+            f"{statistics.median(row[n][0] for row in rows):.1f} ({rows[0][n][1]:,})" for n in names)
+        speedup = [row["scikit-image"][0] / row["skelclimb"][0] for row in rows]
+        against_fe = [row["skelclimb"][0] / row["VTK Flying Edges"][0] for row in rows]
+        print(f"| {label} | {cells} | {ratio(speedup, 1)} | {ratio(against_fe, 2)} |",
+              flush=True)
 
 
 if __name__ == "__main__":
