@@ -859,7 +859,7 @@ impl Grid<'_> {
         (step, flip): (usize, usize),
         entry: &Entry,
     ) -> [u32; 3] {
-        let pentry = &self.entries[(class ^ flip) * 256 + usize::from(cases[step])];
+        let pentry = self.partner(cases, class, (step, flip));
         // The partner adds the outer vertex of its ear that is off the face the two share; the
         // entries say which (`Entry::merge`), so the partner's ear itself is not read.
         let far = cube.next_id(step, pentry.merge[axis]);
@@ -877,17 +877,24 @@ impl Grid<'_> {
         [pick(f, far), pick(b, f), pick(far, b)]
     }
 
+    /// The entry of the merge partner `step` further on, its class `flip`ped.
+    #[inline(always)]
+    fn partner(&self, cases: &[u8], class: usize, (step, flip): (usize, usize)) -> &'static Entry {
+        &self.entries[(class ^ flip) * 256 + usize::from(cases[step])]
+    }
+
     /// Whether the triangle `merged_triangle` made for an owned pair replaces two ears that share
     /// a face side: the partner's ear runs between the triangle's far vertex and the shared one.
     fn ears_share_a_side(
         &self,
         (cube, cases, class): (Cube<'_, '_>, &[u8], usize),
         axis: usize,
-        (step, flip): (usize, usize),
+        pair: (usize, usize),
         entry: &Entry,
         [first, middle, last]: [u32; 3],
     ) -> bool {
-        let pentry = &self.entries[(class ^ flip) * 256 + usize::from(cases[step])];
+        let pentry = self.partner(cases, class, pair);
+        let step = pair.0;
         let [pb, _, pf] = pentry.tris[usize::from(pentry.ears[axis])];
         // The triangle is `[f, b, far]` when the back vertex `b` is shared, else `[far, f, b]`.
         let (far, shared) = if entry.merge[axis] & BACK_SHARED != 0 {
