@@ -445,18 +445,21 @@ impl<'s, T: Scalar> Sweep<'s, T> {
                     let axis = (owned.trailing_zeros() & 3) as usize;
                     let pair = core::hint::select_unpredictable(any, pairs[axis], (0, 0));
                     let owner = (cube, &cases[i..], class);
-                    let t = grid.merged_triangle(owner, axis, pair, entry);
-                    debug_assert!(!any || grid.ears_share_a_side(owner, axis, pair, entry, t));
-                    sink.cube_triangle_if([i + ox, j + oy, k + oz], t, any);
-                    triangles += u64::from(any);
+                    let mut merge = |axis: usize, pair, keep: bool| {
+                        let t = grid.merged_triangle(owner, axis, pair, entry);
+                        debug_assert!(
+                            !keep || grid.ears_share_a_side(owner, axis, pair, entry, t),
+                            "ears around a merged grey edge share a face side"
+                        );
+                        sink.cube_triangle_if([i + ox, j + oy, k + oz], t, keep);
+                        triangles += u64::from(keep);
+                    };
+                    merge(axis, pair, any);
                     let mut more = owned & owned.wrapping_sub(1);
                     while more != 0 {
                         let axis = more.trailing_zeros() as usize;
                         more &= more - 1;
-                        triangles += 1;
-                        let t = grid.merged_triangle(owner, axis, pairs[axis], entry);
-                        debug_assert!(grid.ears_share_a_side(owner, axis, pairs[axis], entry, t));
-                        sink.cube_triangle([i + ox, j + oy, k + oz], t);
+                        merge(axis, pairs[axis], true);
                     }
                 }
                 // Five triangles at most: the mask says so to the compiler, which then drops
