@@ -4,7 +4,7 @@
     python3 bench/slow_cpu.py A B [ROUNDS] [RUNS]
 
 A cloud machine's vCPUs are not always equally fast: on ours, one was at times up to 1.5x
-slower than the other (README, *Where the time goes*), and a two-thread extraction then waits
+slower than the other (docs/speed-log.md), and a two-thread extraction then waits
 for its chunk on the slow one. This makes that happen on demand, so that ways of sharing the
 work can be compared: each build's threads are pinned one per CPU (`taskset -p`, once its
 thread pool has started), and CPU 1 is shared with a process that spins 200 us and sleeps

@@ -50,7 +50,8 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
         );
     }
     // The same with normals through an `Extractor`, which keeps its buffers between calls: what
-    // the allocator costs the line above (see the README's "Repeated extractions and glibc").
+    // the allocator costs the line above (see "Repeated extractions and glibc" in
+    // docs/speed-log.md).
     let params = Params {
         normals: true,
         ..Params::new(iso)
