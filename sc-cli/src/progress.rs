@@ -62,27 +62,88 @@ impl Progress for Bar {
 }
 
 /// A writer that reports the bytes passing through it, so that writing a large mesh shows
-/// progress like reading and meshing do.
+/// progress like reading and meshing do. The writers hand it fields of a few bytes at a time;
+/// it tells the bar only every [`REPORT_EVERY`] bytes, since each report reads the clock twice:
+/// reported per write, a GLB of 229 k triangles took 110–139 ms to write instead of 5.
 pub struct Counted<'a, W> {
     inner: W,
     progress: &'a dyn Progress,
+    /// Bytes written and not yet reported.
+    unreported: u64,
 }
+
+/// Bytes between two reports: a bar's hundredth of any mesh worth a bar.
+const REPORT_EVERY: u64 = 1 << 16;
 
 impl<'a, W: std::io::Write> Counted<'a, W> {
     /// Counts what goes to `inner` into `progress`.
     pub fn new(inner: W, progress: &'a dyn Progress) -> Self {
-        Counted { inner, progress }
+        Counted {
+            inner,
+            progress,
+            unreported: 0,
+        }
+    }
+
+    fn report(&mut self) {
+        self.progress.inc(self.unreported);
+        self.unreported = 0;
     }
 }
 
 impl<W: std::io::Write> std::io::Write for Counted<'_, W> {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         let n = self.inner.write(buf)?;
-        self.progress.inc(n as u64);
+        self.unreported += n as u64;
+        if self.unreported >= REPORT_EVERY {
+            self.report();
+        }
         Ok(n)
     }
 
     fn flush(&mut self) -> std::io::Result<()> {
+        self.report();
         self.inner.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::Write;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    use super::*;
+
+    /// Counts reports and their bytes.
+    #[derive(Default)]
+    struct Tally {
+        reports: AtomicU64,
+        bytes: AtomicU64,
+    }
+
+    impl Progress for Tally {
+        fn phase(&self, _: &'static str, _: u64) {}
+        fn inc(&self, n: u64) {
+            self.reports.fetch_add(1, Ordering::Relaxed);
+            self.bytes.fetch_add(n, Ordering::Relaxed);
+        }
+    }
+
+    /// Every byte is reported by the time the writer is flushed, in a report per
+    /// `REPORT_EVERY` bytes or so rather than one per write.
+    #[test]
+    fn reports_every_byte_in_few_reports() {
+        let tally = Tally::default();
+        let mut out = Vec::new();
+        let mut counted = Counted::new(&mut out, &tally);
+        for i in 0..100_000u32 {
+            counted.write_all(&i.to_le_bytes()).unwrap();
+        }
+        counted.write_all(b"tail").unwrap();
+        counted.flush().unwrap();
+        assert_eq!(out.len(), 400_004);
+        assert_eq!(tally.bytes.load(Ordering::Relaxed), 400_004);
+        let reports = tally.reports.load(Ordering::Relaxed);
+        assert!((6..=8).contains(&reports), "{reports} reports");
     }
 }

@@ -1,5 +1,6 @@
 //! `skelclimb extract`.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -162,7 +163,8 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             ascii: args.ascii,
             space: world.space,
         };
-        output.format.write(&mesh, &options, &mut counted)
+        output.format.write(&mesh, &options, &mut counted)?;
+        counted.flush()
     })?;
     progress.finish();
     let summary = Summary {

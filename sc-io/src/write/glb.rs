@@ -8,7 +8,7 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
-use super::WriteOptions;
+use super::{WriteOptions, le_words};
 use crate::space::Space;
 use serde_json::{Value, json};
 
@@ -41,12 +41,9 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
     if bin_len > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
-        for v in mesh.positions.iter().chain(&mesh.normals).flatten() {
-            out.write_all(&v.to_le_bytes())?;
-        }
-        for i in mesh.triangles.iter().flatten() {
-            out.write_all(&i.to_le_bytes())?;
-        }
+        le_words(&mesh.positions, out, f32::to_le_bytes)?;
+        le_words(&mesh.normals, out, f32::to_le_bytes)?;
+        le_words(&mesh.triangles, out, u32::to_le_bytes)?;
     }
     Ok(())
 }

@@ -5,6 +5,7 @@ use std::io::{self, Write};
 use sc_runtime::Mesh;
 
 use super::WriteOptions;
+use super::text::Lines;
 
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.
 pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
@@ -15,22 +16,31 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
         mesh.triangles.len(),
         options.coordinates()
     )?;
-    for [x, y, z] in &mesh.positions {
-        writeln!(out, "v {x} {y} {z}")?;
-    }
-    for [x, y, z] in &mesh.normals {
-        writeln!(out, "vn {x} {y} {z}")?;
+    let mut lines = Lines::new(out);
+    for (tag, vectors) in [("v ", &mesh.positions), ("vn ", &mesh.normals)] {
+        for &[x, y, z] in vectors {
+            lines
+                .text(tag)
+                .float(x)
+                .text(" ")
+                .float(y)
+                .text(" ")
+                .float(z)
+                .end()?;
+        }
     }
     let with_normals = !mesh.normals.is_empty();
     for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| u64::from(i) + 1);
-        if with_normals {
-            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
-        } else {
-            writeln!(out, "f {a} {b} {c}")?;
+        lines.text("f");
+        for i in t.map(|i| u64::from(i) + 1) {
+            lines.text(" ").int(i);
+            if with_normals {
+                lines.text("//").int(i);
+            }
         }
+        lines.end()?;
     }
-    Ok(())
+    lines.finish()
 }
 
 #[cfg(test)]

@@ -4,7 +4,8 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
-use super::WriteOptions;
+use super::text::Lines;
+use super::{WriteOptions, in_chunks, le_words};
 
 fn header(
     mesh: &Mesh,
@@ -35,9 +36,9 @@ fn header(
 pub fn write_binary(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
     header(mesh, "binary_little_endian", options, out)?;
     let with_normals = !mesh.normals.is_empty();
-    if !with_normals && cfg!(target_endian = "little") {
-        // Positions alone are already the file's records, byte for byte.
-        out.write_all(bytemuck::cast_slice(&mesh.positions))?;
+    if !with_normals {
+        // Positions alone are the file's records.
+        le_words(&mesh.positions, out, f32::to_le_bytes)?;
     } else {
         let vertex_bytes = if with_normals { 24 } else { 12 };
         in_chunks(mesh.positions.len(), vertex_bytes, out, |i, rec| {
@@ -61,39 +62,32 @@ fn put_floats(rec: &mut [u8], values: &[f32; 3]) {
     }
 }
 
-/// Encodes records `0..count` of `record` bytes each with `encode` and writes them in batches.
-fn in_chunks(
-    count: usize,
-    record: usize,
-    out: &mut impl Write,
-    encode: impl Fn(usize, &mut [u8]),
-) -> io::Result<()> {
-    // At least 64 KiB per batch, so that batches bypass the output's `BufWriter`.
-    const BATCH: usize = 8192;
-    let mut buf = vec![0u8; BATCH * record];
-    for start in (0..count).step_by(BATCH) {
-        let n = BATCH.min(count - start);
-        for (k, rec) in buf[..n * record].chunks_exact_mut(record).enumerate() {
-            encode(start + k, rec);
-        }
-        out.write_all(&buf[..n * record])?;
-    }
-    Ok(())
-}
-
 /// ASCII PLY; floats are printed in their shortest exact form, so nothing is lost.
 pub fn write_ascii(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
     header(mesh, "ascii", options, out)?;
+    let mut lines = Lines::new(out);
     for (i, [x, y, z]) in mesh.positions.iter().enumerate() {
-        match mesh.normals.get(i) {
-            Some([a, b, c]) => writeln!(out, "{x} {y} {z} {a} {b} {c}")?,
-            None => writeln!(out, "{x} {y} {z}")?,
+        lines.float(*x).text(" ").float(*y).text(" ").float(*z);
+        if let Some([a, b, c]) = mesh.normals.get(i) {
+            lines
+                .text(" ")
+                .float(*a)
+                .text(" ")
+                .float(*b)
+                .text(" ")
+                .float(*c);
         }
+        lines.end()?;
     }
     for [a, b, c] in &mesh.triangles {
-        writeln!(out, "3 {a} {b} {c}")?;
+        lines
+            .text("3 ")
+            .int(u64::from(*a))
+            .text(" ")
+            .int(u64::from(*b));
+        lines.text(" ").int(u64::from(*c)).end()?;
     }
-    Ok(())
+    lines.finish()
 }
 
 #[cfg(test)]

@@ -4,6 +4,8 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
+use super::in_chunks;
+
 /// Writes the 80-byte header, the triangle count and one 50-byte record per triangle.
 pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     let mut header = [b' '; 80];
@@ -13,14 +15,15 @@ pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     let count = u32::try_from(mesh.triangles.len())
         .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "too many triangles for STL"))?;
     out.write_all(&count.to_le_bytes())?;
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        for v in face_normal(a, b, c).iter().chain(&a).chain(&b).chain(&c) {
-            out.write_all(&v.to_le_bytes())?;
+    in_chunks(mesh.triangles.len(), 50, out, |i, rec| {
+        let [a, b, c] = mesh.triangles[i].map(|v| mesh.positions[v as usize]);
+        let values = face_normal(a, b, c).into_iter().chain(a).chain(b).chain(c);
+        for (field, v) in rec.chunks_exact_mut(4).zip(values) {
+            field.copy_from_slice(&v.to_le_bytes());
         }
-        out.write_all(&[0, 0])?;
-    }
-    Ok(())
+        // The attribute byte count, which no reader uses.
+        rec[48..].fill(0);
+    })
 }
 
 /// The unit normal of triangle `abc` by the right-hand rule, or zero for a degenerate one (STL
