@@ -39,19 +39,22 @@ impl Histogram {
         let scale = grid.scale;
         // Halved, so that values near ±1.7e308 do not overflow `hi − lo` to infinity.
         let width = (hi / 2.0 - lo / 2.0) / bins as f64;
-        let (mut mean, mut n) = (0.0, 0.0);
+        let mut sum = 0.0;
         with_samples!(&grid.samples, v => count(v, |x| {
             let x = scale.apply(x);
             if x.is_finite() {
-                // A running mean cannot overflow where a sum would.
-                n += 1.0;
-                mean += x / n - mean / n;
+                sum += x;
                 let i = if width > 0.0 { ((x / 2.0 - lo / 2.0) / width) as usize } else { 0 };
                 h.counts[i.min(bins - 1)] += 1;
             }
         }));
         if range.finite > 0 {
-            h.mean = mean;
+            let n = range.finite as f64;
+            h.mean = if sum.is_finite() {
+                sum / n
+            } else {
+                running_mean(grid)
+            };
         }
         h
     }
@@ -165,6 +168,22 @@ const PEAK_SHARE: f64 = 1e-3;
 /// Half-width of the smoothing window, in bins.
 const SMOOTH: usize = 3;
 
+/// The mean of the grid's finite values where their sum overflows (values near ±1e308): a
+/// running mean cannot overflow, but its two divisions per sample, one waiting on the other,
+/// took 130 ms of `info` on an 8.7 M-sample MRI, where summing takes a few.
+fn running_mean(grid: &Grid) -> f64 {
+    let scale = grid.scale;
+    let (mut mean, mut n) = (0.0, 0.0);
+    with_samples!(&grid.samples, v => count(v, |x| {
+        let x = scale.apply(x);
+        if x.is_finite() {
+            n += 1.0;
+            mean += x / n - mean / n;
+        }
+    }));
+    mean
+}
+
 fn count<T: Sample>(v: &[T], mut f: impl FnMut(f64)) {
     v.iter().for_each(|x| f(x.to_f64()));
 }
@@ -234,9 +253,19 @@ mod tests {
         let h = Histogram::of(&g, &g.range(), 16);
         assert_eq!(h.counts.iter().sum::<u64>(), 4);
         assert!(h.mean.is_finite());
+        assert!((h.mean - 0.25).abs() < 1e-9, "{}", h.mean);
         assert!((0..=16).all(|i| h.edge(i).is_finite()));
         assert_eq!(h.counts[0], 1);
         assert_eq!(h.counts[15], 1);
+    }
+
+    /// Where the values' sum overflows, the mean is still theirs.
+    #[test]
+    fn mean_of_values_whose_sum_overflows() {
+        let v = vec![1.7e308, 1.7e308, 1.5e308, 1.5e308];
+        let g = Grid::new(Samples::F64(v.into()), [4, 1, 1], "test");
+        let h = Histogram::of(&g, &g.range(), 16);
+        assert!((h.mean / 1.6e308 - 1.0).abs() < 1e-12, "{}", h.mean);
     }
 
     #[test]
