@@ -13,6 +13,10 @@
 //!     .write_with(|out| MeshFormat::Ply.write(&mesh, &WriteOptions::default(), out))?;
 //! # Ok::<(), sc_io::Error>(())
 //! ```
+//!
+//! The [`surface`] module needs the `surface` feature (on by default). It compiles the sweep for
+//! every sample type, most of this crate's build time, so a front end that calls `sc-runtime`
+//! itself (the Python package) or only reads (the fuzzer) turns default features off.
 
 pub mod atomic;
 pub mod buffer;
@@ -22,6 +26,7 @@ pub mod progress;
 pub mod read;
 pub mod shard;
 pub mod space;
+#[cfg(feature = "surface")]
 pub mod surface;
 pub mod volume;
 pub mod write;
