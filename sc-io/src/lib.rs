@@ -3,6 +3,7 @@
 //! same bytes.
 //!
 //! ```no_run
+//! # #[cfg(feature = "surface")] {
 //! use sc_io::{atomic::AtomicFile, progress::Silent, read, surface};
 //! use sc_io::write::{MeshFormat, WriteOptions};
 //!
@@ -11,10 +12,11 @@
 //! let mesh = surface::extract(&grid, &request, &Silent)?;
 //! AtomicFile::create("bone.ply".as_ref())?
 //!     .write_with(|out| MeshFormat::Ply.write(&mesh, &WriteOptions::default(), out))?;
+//! # }
 //! # Ok::<(), sc_io::Error>(())
 //! ```
 //!
-//! The [`surface`] module needs the `surface` feature (on by default). It compiles the sweep for
+//! The `surface` module needs the `surface` feature (on by default). It compiles the sweep for
 //! every sample type, most of this crate's build time, so a front end that calls `sc-runtime`
 //! itself (the Python package) or only reads (the fuzzer) turns default features off.
 
