@@ -19,6 +19,9 @@
 //! The `surface` module needs the `surface` feature (on by default). It compiles the sweep for
 //! every sample type, most of this crate's build time, so a front end that calls `sc-runtime`
 //! itself (the Python package) or only reads (the fuzzer) turns default features off.
+//! The `zarr` feature (on by default) reads Zarr arrays and OME-Zarr images through `zarrs` and
+//! the C libraries of its codecs; without it a Zarr store is refused with a message that says
+//! so, and the build is shorter (the fuzzer has no Zarr target and leaves it off).
 
 pub mod atomic;
 pub mod buffer;

@@ -13,6 +13,10 @@ pub mod payload;
 pub mod raw;
 pub mod sidecar;
 pub mod stream;
+#[cfg(feature = "zarr")]
+pub mod zarr;
+#[cfg(not(feature = "zarr"))]
+#[path = "zarr_off.rs"]
 pub mod zarr;
 
 use std::fs::File;
@@ -81,7 +85,7 @@ impl Format {
             .map(|n| n.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         let ends = |suffixes: &[&str]| suffixes.iter().any(|s| name.ends_with(s));
-        let format = if zarr::is_store(path) {
+        let format = if is_zarr_store(path) {
             Format::Zarr
         } else if path.is_dir() {
             Format::Dicom
@@ -150,6 +154,18 @@ impl Format {
             Format::Sidecar => "raw + JSON sidecar",
         }
     }
+}
+
+/// Whether `path` is a Zarr store: a folder with Zarr metadata, or named `*.zarr`. Recognised
+/// with the `zarr` feature or without it, which then names the format in its refusal.
+fn is_zarr_store(path: &Path) -> bool {
+    path.is_dir()
+        && (["zarr.json", ".zarray", ".zgroup"]
+            .iter()
+            .any(|m| path.join(m).is_file())
+            || path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("zarr")))
 }
 
 /// Reads the volume at `path` in whatever format it is.

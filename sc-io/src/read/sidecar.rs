@@ -143,7 +143,7 @@ mod tests {
         assert_eq!(s.layout.header_bytes, 0);
         assert_eq!(s.spacing, Some([2.0, 2.0, 3.5]));
         assert_eq!(s.origin, None);
-        // In the file's order (serde_json keeps it: zarrs turns on `preserve_order`).
+        // In the file's order (serde_json keeps it: sc-io turns on `preserve_order`).
         assert_eq!(
             s.iso_suggestions,
             [("skin".to_string(), 20.0), ("bone".to_string(), 300.5)]

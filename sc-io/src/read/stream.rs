@@ -101,7 +101,7 @@ impl Stream {
     /// z-slices per read that suit the source: a row of chunks for Zarr, about 16 MiB for files.
     pub fn slab(&self) -> usize {
         match &self.source {
-            Source::Zarr(z) => z.chunk_z.max(1),
+            Source::Zarr(z) => z.chunk_z().max(1),
             Source::Block { layout, .. } => {
                 let [nx, ny, _] = self.grid.dims;
                 (SLAB_BYTES / (nx * ny * layout.dtype.size()).max(1)).max(1)

@@ -14,16 +14,10 @@ use zarrs::group::Group;
 use crate::error::{Error, Result};
 use crate::volume::{Dtype, Grid, Sample, Samples};
 
-/// Whether `path` is a Zarr store: a folder with Zarr metadata, or named `*.zarr`.
-pub fn is_store(path: &Path) -> bool {
-    path.is_dir()
-        && (["zarr.json", ".zarray", ".zgroup"]
-            .iter()
-            .any(|m| path.join(m).is_file())
-            || path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("zarr")))
-}
+/// What a sample type needs to be read from a Zarr array: `zarrs`' element conversion.
+pub trait Element: zarrs::array::ElementOwned {}
+
+impl<T: zarrs::array::ElementOwned> Element for T {}
 
 /// An open Zarr array, read a slab of z-slices at a time.
 pub struct Source {
@@ -31,7 +25,7 @@ pub struct Source {
     /// Leading axes of length 1 (OME-Zarr's `t` and `c`) before `z, y, x`.
     lead: usize,
     /// z-slices per chunk: slabs of whole chunk rows decode each chunk once.
-    pub chunk_z: usize,
+    chunk_z: usize,
 }
 
 /// Opens the array at `path` (or multiscale level `level` of an OME-Zarr image there): the grid
@@ -152,6 +146,11 @@ pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
 }
 
 impl Source {
+    /// z-slices per chunk: slabs of whole chunk rows decode each chunk once.
+    pub fn chunk_z(&self) -> usize {
+        self.chunk_z
+    }
+
     /// z-slices `z0..z1`, x fastest.
     pub fn read<T: Sample>(&self, path: &Path, z0: usize, z1: usize) -> Result<Vec<T>> {
         let shape = self.array.shape();
