@@ -47,7 +47,7 @@ def main():
                 start = time.perf_counter()
                 calls[which](vol, iso)
                 times[which].append(1000 * (time.perf_counter() - start))
-        ratios = sorted(theirs / ours for ours, theirs in zip(*times))
+        ratios = [theirs / ours for ours, theirs in zip(*times)]
         q1, _, q3 = statistics.quantiles(ratios, n=4) if len(ratios) > 1 else ratios * 3
         print(
             f"| {label} | {statistics.median(ratios):.1f}× ({q1:.1f}–{q3:.1f}) "
