@@ -32,8 +32,10 @@ cargo afl config --build >/dev/null 2>&1 || true
 # then build plainly: a cold build takes 2 minutes instead of 3. AFL_OPT_LEVEL (cargo-afl's,
 # default 3) trades execution speed for build time; CI's short run uses 1.
 host=$(rustc -vV | awk '$1 == "host:" { print $2 }')
-cargo afl build --release --locked --bin read --target "$host"
+cargo afl build --release --locked --bin read --bin zarr_off --target "$host"
 binary=$CARGO_TARGET_DIR/$host/release/read
+# sc-io is built here without its `zarr` feature: a Zarr store must be refused, naming it.
+"$CARGO_TARGET_DIR/$host/release/zarr_off"
 
 # Containers and CI machines: no core_pattern or CPU frequency tuning, no pinning, no UI.
 export AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1 AFL_SKIP_CPUFREQ=1 AFL_NO_AFFINITY=1 AFL_NO_UI=1
