@@ -18,7 +18,9 @@ fn main() {
         Err(e) => e.to_string(),
     };
     if !(error.contains("volume.zarr") && error.contains("`zarr` feature")) {
-        fail(&format!("the refusal names neither the store nor the feature: {error}"));
+        fail(&format!(
+            "the refusal does not name the store and the feature: {error}"
+        ));
     }
     println!("without the zarr feature, a Zarr store is refused: {error}");
 }
