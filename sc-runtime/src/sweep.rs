@@ -615,9 +615,7 @@ impl Out<'_> {
             // An `if`, not `bool::then` with a closure: in the Python extension's build the
             // closure was left out of line, three calls per vertex and 40 % more normals time.
             let normal = if NORMALS {
-                // Whether the lower end is filled, from its sample (the classification's test,
-                // exactly): its classified byte is a bounds-checked row away.
-                Some(field.normal::<AXIS>(row.normals, p, t, ends.0 >= params.iso))
+                Some(field.normal::<AXIS>(row.normals, p, ends, params.iso))
             } else {
                 None
             };
