@@ -1,7 +1,10 @@
 //! Times one volume's extraction, for profiling and for comparing variants of the sweep:
 //! the median of `RUNS` single-threaded extractions (normals off unless `--normals`), in each
-//! mode given. Under `valgrind --tool=callgrind` pass `RUNS` = 1: instruction counts, unlike
-//! seconds, do not move with the machine's load.
+//! mode given. `--python` adds the values and the `(z, y, x)` coordinates that the Python
+//! package's `marching_cubes` asks for: the sweep's copy for that output is compiled apart, and
+//! a change can speed one copy and not the other (see `docs/speed-log.md`, after `b78d4f4`).
+//! Under `valgrind --tool=callgrind` pass `RUNS` = 1: instruction counts, unlike seconds, do not
+//! move with the machine's load.
 //!
 //! ```sh
 //! cargo run --release -p sc-runtime --example time_extract -- \
@@ -11,13 +14,13 @@
 
 use std::time::Instant;
 
-use sc_runtime::{Mode, Params, Scalar, Volume, extract_par};
+use sc_runtime::{Axes, Mode, Params, Scalar, Volume, extract_par};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let [_, path, dims, dtype, iso, runs, modes, rest @ ..] = args.as_slice() else {
         return Err(
-            "usage: time_extract VOLUME.raw NX,NY,NZ DTYPE ISO RUNS MODE[,MODE…] [--normals] [--threads N]"
+            "usage: time_extract VOLUME.raw NX,NY,NZ DTYPE ISO RUNS MODE[,MODE…] [--normals] [--python] [--threads N]"
                 .into(),
         );
     };
@@ -28,6 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         iso: iso.parse()?,
         runs: runs.parse()?,
         normals: rest.iter().any(|a| a == "--normals"),
+        python: rest.iter().any(|a| a == "--python"),
         threads: rest
             .iter()
             .position(|a| a == "--threads")
@@ -72,6 +76,8 @@ struct Options {
     iso: f64,
     runs: usize,
     normals: bool,
+    /// Values and `(z, y, x)` coordinates, as the Python package's `marching_cubes` asks.
+    python: bool,
     threads: usize,
 }
 
@@ -85,6 +91,8 @@ fn time<T: Scalar>(
     let params = Params {
         mode,
         normals: options.normals,
+        values: options.python,
+        axes: if options.python { Axes::Zyx } else { Axes::Xyz },
         ..Params::new(options.iso)
     };
     let mut times = Vec::with_capacity(options.runs);
