@@ -12,6 +12,13 @@ impl<T> Slices<T> for InMemory<'_, T> {
     fn slice(&self, z: usize) -> &[T] {
         &self.data[z * self.nxy..(z + 1) * self.nxy]
     }
+
+    #[inline]
+    fn ahead(&self, z: usize) -> &[T] {
+        self.data
+            .get(z * self.nxy..(z + 1) * self.nxy)
+            .unwrap_or(&[])
+    }
 }
 
 /// Whether the grid has any cube: dims below 2 on an axis give an empty mesh.

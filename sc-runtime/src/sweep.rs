@@ -19,11 +19,13 @@ use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::{BACK_SHARED, Entry};
 use crate::vertex::{Field, InteriorPlane, InteriorRow, Steps, wide_crossing};
 
+mod ahead;
 mod bound;
 mod cube_ids;
 mod edge_row;
 mod greys;
 use crate::{Axes, Error, Mode, Params, Scalar, Sink, Stats};
+use ahead::Ahead;
 use cube_ids::{Cube, CubeIds};
 use edge_row::EdgeRow;
 use greys::{Around, Greys};
@@ -52,6 +54,12 @@ const MERGED: u32 = u32::MAX;
 /// Gives the sweep the slices it asks for; `z` is always within what the step needs.
 pub(crate) trait Slices<T> {
     fn slice(&self, z: usize) -> &[T];
+    /// Slice `z` if it is in memory already, so that it can be fetched into the cache before it
+    /// is needed ([`Ahead`]); empty past the grid and for a source that reads slices as the
+    /// sweep goes.
+    fn ahead(&self, _z: usize) -> &[T] {
+        &[]
+    }
 }
 
 /// What Step 4 does with an occupied grey edge.
@@ -243,12 +251,15 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         with_output!(self, vertex_passes(k, src, sink))?;
         let (own_lo, own_hi) = self.grid.own_cubes[2];
         if (own_lo..own_hi).contains(&k) {
+            // Slice `k + 3`, which layer `k + 1` classifies first.
+            let (y_lo, y_hi) = self.grid.own_cubes[1];
+            let ahead = Ahead::new(src.ahead(k + 3), y_hi.saturating_sub(y_lo));
             if self.grid.mode == Mode::Steps123 {
-                self.triangles::<false, 0>(k, sink);
+                self.triangles::<false, 0>(k, sink, &ahead);
             } else if k.is_multiple_of(2) {
-                self.triangles::<true, 0>(k, sink);
+                self.triangles::<true, 0>(k, sink, &ahead);
             } else {
-                self.triangles::<true, 3>(k, sink);
+                self.triangles::<true, 3>(k, sink, &ahead);
             }
         }
         if self.out.emit {
@@ -392,10 +403,15 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     /// (`MERGING`, a constant so that Steps 1–3 get a copy without the merge marks). `SHIFT` is
     /// where layer `k`'s marks lie in their bytes, `3 · (k % 2)` (see [`Out::merged`]): a
     /// constant, one copy per layer parity, as a shift by a variable cost the merging pass two
-    /// instructions per crossed cube.
+    /// instructions per crossed cube. Each cube row also fetches its share of the slice `ahead`.
     // Not inlined: each pass runs once per layer, and apart it shows in a profile.
     #[inline(never)]
-    fn triangles<const MERGING: bool, const SHIFT: u8>(&mut self, k: usize, sink: &mut impl Sink) {
+    fn triangles<const MERGING: bool, const SHIFT: u8>(
+        &mut self,
+        k: usize,
+        sink: &mut impl Sink,
+        ahead: &Ahead,
+    ) {
         let [nx, ny, _] = self.grid.dims;
         let nxy = nx * ny;
         let grid = &self.grid;
@@ -409,6 +425,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         let spans = (k % 3) * ny;
         let pairs = grid.partners(k);
         for j in y_lo..y_hi {
+            ahead.fetch(j - y_lo);
             let (start, end) = lo_hi(grid.case_spans[spans + j]);
             let cases = &grid.cases[(k % 3) * nxy + j * nx..];
             let class_jk = ((j + oy) & 1) << 1 | ((k + oz) & 1) << 2;
