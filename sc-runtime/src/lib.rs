@@ -43,6 +43,7 @@ mod survey;
 pub use block::{BlockMesh, block_samples, edge_key, extract_block};
 
 mod extract;
+mod prefetch;
 mod stream;
 pub use extract::extract_into;
 pub use stream::SliceStreamer;

@@ -14,8 +14,8 @@
 
 use alloc::vec::Vec;
 
-use crate::Scalar;
 use crate::sweep::Slices;
+use crate::{Scalar, prefetch};
 
 /// Slices between the sampled ones, at most.
 const SLICE_STEP: usize = 8;
@@ -98,6 +98,16 @@ pub(crate) fn sampled_slice<T: Scalar>(
         |a: &[u8], b: &[u8]| a.iter().zip(b).map(|(a, b)| u32::from(a ^ b)).sum::<u32>() as usize;
     let mut n = 0;
     for y in (0..ny).step_by(ROW_STEP) {
+        // The rows two steps on, asked for now: each row is a short run of lines of its own,
+        // and read when needed each waited on memory (the survey was 3.8 % of the `f32` MNI
+        // brain's extraction).
+        let ahead = y + 2 * ROW_STEP;
+        if let Some(rows) = here.get(ahead * nx..) {
+            prefetch::all(&rows[..rows.len().min(2 * nx)]);
+        }
+        if let Some(rows) = above.and_then(|above| above.get(ahead * nx..)) {
+            prefetch::all(&rows[..rows.len().min(nx)]);
+        }
         T::classify_row(&here[y * nx..][..nx], threshold, row);
         n += differ(&row[1..], &row[..nx - 1]);
         if y + 1 < ny {

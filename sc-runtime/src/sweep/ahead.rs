@@ -6,11 +6,9 @@
 //! `k`'s triangle pass, a share per cube row, overlaps that read with the pass's work, so that
 //! layer `k + 1` classifies from L2: 0.89–0.93 times the time on the `f32` MNI brain, 0.92–0.94
 //! on the stent CT at 256³, 0.96–0.97 on the stent at 281 and the `u8` MNI brain, 0.98–0.99 on
-//! the small MRIs (`time_extract`, docs/speed-log.md). A prefetch is only a hint: it reads
-//! nothing and changes no result.
+//! the small MRIs (`time_extract`, docs/speed-log.md).
 
-/// Bytes per cache line, the step between prefetches.
-const LINE: usize = 64;
+use crate::prefetch::{self, LINE};
 
 /// The bytes of a slice ahead, cut into one share per cube row of a triangle pass.
 pub(super) struct Ahead {
@@ -39,22 +37,11 @@ impl Ahead {
         (first..end).step_by(LINE)
     }
 
-    /// Asks for row `row`'s share of the slice to be brought into L2 (`_MM_HINT_T1`: the next
-    /// layer's classification reads it, and L1 could not hold a slice). Elsewhere than on
-    /// x86-64, nothing.
+    /// Asks for row `row`'s share of the slice to be brought into the cache ([`prefetch::line`]).
     #[inline(always)]
     pub fn fetch(&self, row: usize) {
         for offset in self.lines(row) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                use core::arch::x86_64::{_MM_HINT_T1, _mm_prefetch};
-                // SAFETY: a prefetch does not access memory in the language's sense (it cannot
-                // fault, and reads nothing the program sees); the address lies within the
-                // slice anyway, `offset < len`.
-                unsafe { _mm_prefetch::<_MM_HINT_T1>(self.start.wrapping_add(offset).cast()) };
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            let _ = (self.start, offset);
+            prefetch::line(self.start.wrapping_add(offset));
         }
     }
 }
