@@ -2,6 +2,8 @@
 //! classification of each slice ([`crate::sweep`]'s slice ahead) and the survey's scattered rows.
 //! A prefetch is only a hint: it reads nothing the program sees and changes no result.
 
+use core::ops::Range;
+
 /// Bytes per cache line, the step between prefetches.
 pub(crate) const LINE: usize = 64;
 
@@ -20,12 +22,17 @@ pub(crate) fn line(p: *const u8) {
     let _ = p;
 }
 
-/// [`line`] for every line of `data`.
+/// [`line`] for every line of the bytes `bytes` from `start`.
+#[inline(always)]
+pub(crate) fn lines(start: *const u8, bytes: Range<usize>) {
+    for offset in bytes.step_by(LINE) {
+        line(start.wrapping_add(offset));
+    }
+}
+
+/// [`lines`] for all of `data`.
 #[cfg(feature = "alloc")]
 #[inline(always)]
 pub(crate) fn all<T>(data: &[T]) {
-    let start: *const u8 = data.as_ptr().cast();
-    for offset in (0..size_of_val(data)).step_by(LINE) {
-        line(start.wrapping_add(offset));
-    }
+    lines(data.as_ptr().cast(), 0..size_of_val(data));
 }

@@ -52,9 +52,9 @@ pub(crate) fn wide_crossing(a: f64, b: f64, iso: f64) -> f64 {
 /// `|b − a|`: a normal is a direction, and weights made of the samples alone keep the crossing's
 /// division off the normal's chain of long-latency steps (about 0.96 times the extraction's time
 /// with normals in the plain output's copy of the sweep; the values-and-`(z, y, x)` copy the
-/// Python package uses did not gain). Not clamped as [`crossing`] clamps the vertex: scikit-image's normals are not
-/// either, the clamp moves a normal by at most 1/1024 of its gradients' difference, and it cost
-/// nine instructions per vertex.
+/// Python package uses did not gain). Not clamped as [`crossing`] clamps the vertex:
+/// scikit-image's normals are not either, the clamp moves a normal by at most 1/1024 of its
+/// gradients' difference, and it cost nine instructions per vertex.
 #[inline(always)]
 fn weights(a: f64, b: f64, iso: f64) -> [f64; 2] {
     [(b - iso).abs(), (a - iso).abs()]

@@ -8,6 +8,8 @@
 //! on the stent CT at 256³, 0.96–0.97 on the stent at 281 and the `u8` MNI brain, 0.98–0.99 on
 //! the small MRIs (`time_extract`, docs/speed-log.md).
 
+use core::ops::Range;
+
 use crate::prefetch::{self, LINE};
 
 /// The bytes of a slice ahead, cut into one share per cube row of a triangle pass.
@@ -29,20 +31,16 @@ impl Ahead {
         }
     }
 
-    /// The offsets from the slice's start of the lines row `row` fetches: its share, one per
-    /// line, clipped to the slice.
-    fn lines(&self, row: usize) -> impl Iterator<Item = usize> {
+    /// The bytes row `row` fetches, from the slice's start: its share, clipped to the slice.
+    fn share(&self, row: usize) -> Range<usize> {
         let first = row.saturating_mul(self.share).min(self.len);
-        let end = first.saturating_add(self.share).min(self.len);
-        (first..end).step_by(LINE)
+        first..first.saturating_add(self.share).min(self.len)
     }
 
     /// Asks for row `row`'s share of the slice to be brought into the cache ([`prefetch::line`]).
     #[inline(always)]
     pub fn fetch(&self, row: usize) {
-        for offset in self.lines(row) {
-            prefetch::line(self.start.wrapping_add(offset));
-        }
+        prefetch::lines(self.start, self.share(row));
     }
 }
 
@@ -61,8 +59,9 @@ mod tests {
             for rows in [0, 1, 2, 7, 232, 5000] {
                 let check = |size: usize, ahead: Ahead| {
                     let len = samples * size;
-                    let lines: Vec<usize> =
-                        (0..rows.max(1)).flat_map(|row| ahead.lines(row)).collect();
+                    let lines: Vec<usize> = (0..rows.max(1))
+                        .flat_map(|row| ahead.share(row).step_by(LINE))
+                        .collect();
                     let want: Vec<usize> = (0..len).step_by(LINE).collect();
                     assert_eq!(
                         lines, want,
