@@ -16,6 +16,7 @@ use core::ops::Range;
 
 use crate::extract::InMemory;
 use crate::mesh::OwnedScratch;
+use crate::sink::Unsettled;
 use crate::sweep::Sweep;
 use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
 
@@ -119,6 +120,8 @@ struct Collect {
     normals: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
     cubes: Vec<u64>,
+    /// The normals are scaled a layer at a time ([`Sink::settle_normals`]).
+    unsettled: Unsettled,
 }
 
 impl Sink for Collect {
@@ -137,9 +140,28 @@ impl Sink for Collect {
         position: [f32; 3],
         normal: Option<[f32; 3]>,
     ) {
+        if normal.is_some() {
+            self.unsettled.before_unit(&mut self.normals, &mut []);
+        }
         self.keys.push(edge_key(self.grid, lower, axis));
         self.positions.push(position);
         self.normals.extend(normal);
+    }
+
+    fn edge_vertex_toward(
+        &mut self,
+        lower: [usize; 3],
+        axis: usize,
+        position: [f32; 3],
+        toward: [f32; 3],
+    ) {
+        self.keys.push(edge_key(self.grid, lower, axis));
+        self.positions.push(position);
+        self.normals.push(toward);
+    }
+
+    fn settle_normals(&mut self) {
+        self.unsettled.settle(&mut self.normals, &mut []);
     }
 
     fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {
@@ -204,6 +226,7 @@ pub fn extract_block<T: Scalar>(
         normals: Vec::new(),
         triangles: Vec::new(),
         cubes: Vec::new(),
+        unsettled: Unsettled::default(),
     };
     let mut scratch = OwnedScratch::new(dims)?;
     let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());

@@ -60,7 +60,12 @@ impl Extractor {
             let survey = Survey::new(&src, dims, T::threshold(params.iso));
             mesh.reserve_for(survey.between(0, dims[2]), params);
         }
-        mesh.stats = extract_into(volume, params, self.scratch.lend(), &mut Presized(mesh))?;
+        mesh.stats = extract_into(
+            volume,
+            params,
+            self.scratch.lend(),
+            &mut Presized::new(mesh),
+        )?;
         Ok(&self.mesh)
     }
 

@@ -1,6 +1,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use crate::sink::Unsettled;
 use crate::{Error, Params, Scratch, Sink, Stats};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
@@ -63,6 +64,8 @@ impl Mesh {
 /// [`Sink::vertex`], [`Sink::vertex_value`] and [`Sink::triangle`] for a type with
 /// `positions`, `normals`, `values` and `triangles` fields that each have a `push`: the mesh's
 /// vectors, and a parallel chunk's stretches of them.
+/// `push_to_columns!(values and triangles)` leaves [`Sink::vertex`] out, for a type that keeps
+/// its normals unsettled (see [`Unsettled`]).
 macro_rules! push_to_columns {
     () => {
         #[inline]
@@ -73,6 +76,9 @@ macro_rules! push_to_columns {
             }
         }
 
+        push_to_columns!(values and triangles);
+    };
+    (values and triangles) => {
         #[inline]
         fn vertex_value(&mut self, value: f32) {
             self.values.push(value);
@@ -140,28 +146,57 @@ impl Sink for Mesh {
 /// growth hints. The hints extrapolate the layers done over the layers left; on a surface dense
 /// in its first layers (the ITK MRI) they asked for up to 1.6 times the survey's reservation,
 /// though the whole surface fitted in it, and each extraction copied its vectors into fresh
-/// pages. Should the survey fall short, the vectors still grow as vectors do.
-pub(crate) struct Presized<'m>(pub &'m mut Mesh);
+/// pages. Should the survey fall short, the vectors still grow as vectors do. It scales normals
+/// a layer at a time ([`Sink::settle_normals`]).
+pub(crate) struct Presized<'m> {
+    mesh: &'m mut Mesh,
+    unsettled: Unsettled,
+}
+
+impl<'m> Presized<'m> {
+    pub fn new(mesh: &'m mut Mesh) -> Self {
+        let unsettled = Unsettled::from(mesh.normals.len());
+        Presized { mesh, unsettled }
+    }
+}
 
 impl Sink for Presized<'_> {
     #[inline]
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
-        self.0.vertex(position, normal);
+        if normal.is_some() {
+            self.unsettled.before_unit(&mut self.mesh.normals, &mut []);
+        }
+        self.mesh.vertex(position, normal);
+    }
+
+    #[inline]
+    fn edge_vertex_toward(
+        &mut self,
+        _: [usize; 3],
+        _: usize,
+        position: [f32; 3],
+        toward: [f32; 3],
+    ) {
+        self.mesh.vertex(position, Some(toward));
+    }
+
+    fn settle_normals(&mut self) {
+        self.unsettled.settle(&mut self.mesh.normals, &mut []);
     }
 
     #[inline]
     fn vertex_value(&mut self, value: f32) {
-        self.0.vertex_value(value);
+        self.mesh.vertex_value(value);
     }
 
     #[inline]
     fn triangle(&mut self, triangle: [u32; 3]) {
-        self.0.triangle(triangle);
+        self.mesh.triangle(triangle);
     }
 
     #[inline]
     fn cube_triangle_if(&mut self, cube: [usize; 3], triangle: [u32; 3], keep: bool) {
-        self.0.cube_triangle_if(cube, triangle, keep);
+        self.mesh.cube_triangle_if(cube, triangle, keep);
     }
 }
 

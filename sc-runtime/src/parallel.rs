@@ -9,6 +9,7 @@ use crate::claims::{Claims, Progress};
 use crate::extract::{InMemory, has_cubes};
 use crate::mesh::{OwnedScratch, push_to_columns, release_spare};
 use crate::region::{self, Filled, Stretch};
+use crate::sink::Unsettled;
 use crate::spare::SPARES;
 use crate::survey::{self, Survey};
 use crate::sweep::Sweep;
@@ -18,16 +19,45 @@ use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
 /// chunks waste work.
 const MIN_CHUNK_LAYERS: usize = 8;
 
-/// Where a chunk writes: its stretches of the output's vectors.
+/// Where a chunk writes: its stretches of the output's vectors. It scales normals a layer at a
+/// time ([`Sink::settle_normals`]).
 struct Region<'a> {
     positions: Stretch<'a, [f32; 3]>,
     normals: Stretch<'a, [f32; 3]>,
     values: Stretch<'a, f32>,
     triangles: Stretch<'a, [u32; 3]>,
+    unsettled: Unsettled,
 }
 
 impl Sink for Region<'_> {
-    push_to_columns!();
+    push_to_columns!(values and triangles);
+
+    #[inline]
+    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
+        self.positions.push(position);
+        if let Some(n) = normal {
+            let (head, tail) = self.normals.written_mut();
+            self.unsettled.before_unit(head, tail);
+            self.normals.push(n);
+        }
+    }
+
+    #[inline]
+    fn edge_vertex_toward(
+        &mut self,
+        _: [usize; 3],
+        _: usize,
+        position: [f32; 3],
+        toward: [f32; 3],
+    ) {
+        self.positions.push(position);
+        self.normals.push(toward);
+    }
+
+    fn settle_normals(&mut self) {
+        let (head, tail) = self.normals.written_mut();
+        self.unsettled.settle(head, tail);
+    }
 }
 
 impl Region<'_> {
@@ -44,6 +74,7 @@ impl Region<'_> {
             triangles: self
                 .triangles
                 .split_off(self.triangles.len() + Mesh::triangle_room(vertices)),
+            unsettled: Unsettled::default(),
         }
     }
 }
@@ -161,6 +192,7 @@ pub fn extract_par<T: Scalar>(
             normals,
             values,
             triangles,
+            unsettled: Unsettled::default(),
         })
         .collect();
     let scratches = (0..workers)

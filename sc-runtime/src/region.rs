@@ -39,6 +39,14 @@ impl<T> Stretch<'_, T> {
         }
     }
 
+    /// The elements pushed, in order: those in the stretch's slots, then those spilled.
+    pub fn written_mut(&mut self) -> (&mut [T], &mut [T]) {
+        let head: *mut [MaybeUninit<T>] = &mut self.slots[..self.len];
+        // SAFETY: pushes wrote the first `len` slots (a slot written but not kept lies past
+        // them), and `MaybeUninit<T>` has `T`'s layout.
+        (unsafe { &mut *(head as *mut [T]) }, &mut self.spill)
+    }
+
     /// Elements pushed.
     pub fn len(&self) -> usize {
         self.len + self.spill.len()

@@ -17,7 +17,7 @@ use wide::u8x16;
 
 use crate::scratch::{PAD, Scratch, WORD_PLANES};
 use crate::tables::{BACK_SHARED, Entry};
-use crate::vertex::{Field, InteriorPlane, InteriorRow, Steps, wide_crossing};
+use crate::vertex::{Field, InteriorPlane, InteriorRow, Normal, Steps, wide_crossing};
 
 mod ahead;
 mod bound;
@@ -218,6 +218,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         self.first_layer = z0;
         self.out.emit = emit_plane;
         let r = with_output!(self, plane_vertices(z0, src, sink));
+        sink.settle_normals();
         self.out.emit = true;
         r
     }
@@ -249,6 +250,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             }
         }
         with_output!(self, vertex_passes(k, src, sink))?;
+        sink.settle_normals();
         let (own_lo, own_hi) = self.grid.own_cubes[2];
         if (own_lo..own_hi).contains(&k) {
             // Slice `k + 3`, which layer `k + 1` classifies first.
@@ -649,7 +651,7 @@ fn send<T, const AXIS: usize, const ZYX: bool>(
     row: &RowContext<'_, '_, T, AXIS>,
     p: [usize; 3],
     t: f64,
-    normal: Option<[f32; 3]>,
+    normal: Option<Normal>,
     (a, b): (f64, f64),
     sink: &mut impl Sink,
 ) {
@@ -664,10 +666,15 @@ fn send<T, const AXIS: usize, const ZYX: bool>(
             _ => row.fixed[d],
         }
     });
-    if ZYX {
-        sink.edge_vertex(global, AXIS, reversed(pos), normal.map(reversed));
+    let (pos, normal) = if ZYX {
+        (reversed(pos), normal.map(Normal::reversed))
     } else {
-        sink.edge_vertex(global, AXIS, pos, normal);
+        (pos, normal)
+    };
+    match normal {
+        Some(Normal::Toward(toward)) => sink.edge_vertex_toward(global, AXIS, pos, toward),
+        Some(Normal::Unit(normal)) => sink.edge_vertex(global, AXIS, pos, Some(normal)),
+        None => sink.edge_vertex(global, AXIS, pos, None),
     }
     if params.values {
         // As NumPy's `maximum`: a NaN end gives NaN.

@@ -80,6 +80,95 @@ mod root {
 }
 use root::{sqrt, sqrtf};
 
+/// A vertex's normal as the sweep hands it to its sink.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Normal {
+    /// An outward direction whose squared length is a normal `f32` ([`scalable`]): the unit
+    /// normal is [`unit`] of it, which the sink computes, at once or later with others.
+    Toward([f32; 3]),
+    /// The unit normal itself, computed in `f64` where `f32` fell short.
+    Unit([f32; 3]),
+}
+
+impl Normal {
+    /// The unit normal.
+    #[cfg(test)]
+    pub fn unit(self) -> [f32; 3] {
+        match self {
+            Normal::Toward(d) => unit(d),
+            Normal::Unit(n) => n,
+        }
+    }
+
+    /// The coordinates in `(z, y, x)` order (see [`Axes::Zyx`](crate::Axes::Zyx)).
+    #[inline(always)]
+    pub fn reversed(self) -> Normal {
+        let r = |[x, y, z]: [f32; 3]| [z, y, x];
+        match self {
+            Normal::Toward(d) => Normal::Toward(r(d)),
+            Normal::Unit(n) => Normal::Unit(r(n)),
+        }
+    }
+}
+
+/// The squared length of `d`, summed as `(x² + z²) + y²`: [`unit`] and [`units`] give the same
+/// bits, and so does a direction in `(z, y, x)` order ([`Normal::reversed`]), which a sink
+/// scales after the sweep reversed it.
+#[inline(always)]
+fn squared([x, y, z]: [f32; 3]) -> f32 {
+    (x * x + z * z) + y * y
+}
+
+/// Whether a squared length is a normal, finite `f32` (NaN is not), tested on the bits: positive
+/// normal floats are the bit patterns `MIN_POSITIVE ..= MAX`'s, and one unsigned compare finds
+/// them. Only then does `f32` give a direction's unit vector accurately.
+#[inline(always)]
+fn scalable(squared: f32) -> bool {
+    let low = f32::MIN_POSITIVE.to_bits();
+    squared.to_bits().wrapping_sub(low) <= f32::MAX.to_bits() - low
+}
+
+/// The unit vector along `d`, a [`Normal::Toward`]'s direction: `d` times `1 / √(d · d)`.
+#[inline]
+pub(crate) fn unit(d: [f32; 3]) -> [f32; 3] {
+    debug_assert!(scalable(squared(d)));
+    let r = 1.0 / sqrtf(squared(d));
+    d.map(|c| c * r)
+}
+
+/// [`unit`] of every direction in `ds`, in place, four at a time: a square root and a division
+/// per vertex, each waiting on the last, stalled the vertex passes, and four lanes at once do
+/// not wait (see [`Sink::edge_vertex_toward`](crate::Sink::edge_vertex_toward)). The bits are
+/// [`unit`]'s: the same correctly rounded operations, lane by lane.
+#[cfg(feature = "alloc")]
+pub(crate) fn units(ds: &mut [[f32; 3]]) {
+    let mut fours = ds.chunks_exact_mut(4);
+    for four in &mut fours {
+        let r = f32x4::ONE / sqrt4(f32x4::new([0, 1, 2, 3].map(|i| squared(four[i]))));
+        for (d, r) in four.iter_mut().zip(r.to_array()) {
+            *d = d.map(|c| c * r);
+        }
+    }
+    for d in fours.into_remainder() {
+        *d = unit(*d);
+    }
+}
+
+/// Four square roots, correctly rounded as [`sqrtf`]'s: one instruction on x86-64 (SSE), lane
+/// by lane elsewhere, where `wide`'s fallback without `std` is a root of its own.
+#[cfg(feature = "alloc")]
+#[inline(always)]
+fn sqrt4(s: f32x4) -> f32x4 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        s.sqrt()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        f32x4::new(s.to_array().map(sqrtf))
+    }
+}
+
 /// The gradient's reciprocal steps, per axis, for one-sided and central differences, relative to
 /// the smallest spacing: a normal is a direction, so one scale for all three axes does not change
 /// it, and steps of at most one keep `f32` gradients of integer samples far from overflow.
@@ -196,12 +285,13 @@ impl<'v, T: Scalar> Field<'v, T> {
         })
     }
 
-    /// The outward unit normal where level `iso` crosses the edge from `p` along `AXIS`, whose
+    /// The outward normal where level `iso` crosses the edge from `p` along `AXIS`, whose
     /// samples are `(a, b)`: the negated gradient interpolated there ([`weights`]), or the edge
     /// direction where it vanishes or is NaN.
     /// Computed in `f32`, a vertex's gradient in one vector, since the result is `f32` anyway:
     /// brainsmall's normals took 8.2 M instructions in `f64`, 7.2 M so. Where the squared
-    /// length leaves `f32`'s normal range, in `f64`.
+    /// length leaves `f32`'s normal range, in `f64`. Otherwise it is left to the sink to scale
+    /// ([`Normal::Toward`]).
     /// Inlined into each vertex pass: as a call it spilled the pass's registers, and brainsmall's
     /// normals cost 10 % more time.
     #[inline(always)]
@@ -211,7 +301,7 @@ impl<'v, T: Scalar> Field<'v, T> {
         p: [usize; 3],
         (a, b): (f64, f64),
         iso: f64,
-    ) -> [f32; 3] {
+    ) -> Normal {
         let (ga, gb) = row.and_then(|r| r.pair(p[0])).unwrap_or_else(|| {
             let mut q = p;
             q[AXIS] += 1;
@@ -221,18 +311,13 @@ impl<'v, T: Scalar> Field<'v, T> {
         // The gradient, not yet negated: the negation goes into the reciprocal length below, one
         // sign instead of three (and the same bits: a sign change is exact).
         let g = ga * wa + gb * wb;
-        let [x, y, z, _] = (g * g).to_array();
+        let [x, y, z, _] = (-g).to_array();
         // The test reads the squared length, not its root: a branch on the root would wait for
         // the square root's long latency, and that wait was a quarter of what normals cost.
-        let squared = x + y + z;
-        // Normal and finite (NaN fails), tested on the bits: positive normal floats are the bit
-        // patterns `MIN_POSITIVE ..= MAX`'s, and one unsigned compare finds them.
-        let low = f32::MIN_POSITIVE.to_bits();
-        if squared.to_bits().wrapping_sub(low) <= f32::MAX.to_bits() - low {
-            let [x, y, z, _] = (g * f32x4::splat(-1.0 / sqrtf(squared))).to_array();
-            [x, y, z]
+        if scalable(squared([x, y, z])) {
+            Normal::Toward([x, y, z])
         } else {
-            self.wide_normal::<AXIS>(p, (a, b), iso)
+            Normal::Unit(self.wide_normal::<AXIS>(p, (a, b), iso))
         }
     }
 
@@ -356,7 +441,7 @@ impl<T: Scalar, const AXIS: usize> InteriorRow<'_, '_, T, AXIS> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Field, Steps};
+    use super::{Field, Steps, scalable, squared, unit, units};
     use alloc::vec::Vec;
     use wide::f32x4;
 
@@ -484,7 +569,7 @@ mod tests {
             if length < 0.05 * scale {
                 continue;
             }
-            let n = field.normal::<AXIS>(row, p, (a, b), a + t * (b - a));
+            let n = field.normal::<AXIS>(row, p, (a, b), a + t * (b - a)).unit();
             for d in 0..3 {
                 let want = -g[d] / length;
                 assert!(
@@ -526,13 +611,45 @@ mod tests {
         }
     }
 
+    /// Scaled four at a time or one at a time, and in `(z, y, x)` order, directions give the same
+    /// bits, whatever their number (whole fours and a remainder) and lengths (from tiny to huge,
+    /// as long as the squared length is a normal `f32`).
+    #[test]
+    fn units_are_unit_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        for len in 0..=9 {
+            for scale in [1e-15, 1e-3, 1.0, 7.0, 1e15] {
+                let ds: Vec<[f32; 3]> = (0..len)
+                    .map(|_| [next(), next(), next()].map(|c| c * scale))
+                    .collect();
+                let mut batch = ds.clone();
+                units(&mut batch);
+                for (d, n) in ds.iter().zip(&batch) {
+                    assert!(scalable(squared(*d)), "{d:?}");
+                    assert_eq!(unit(*d).map(f32::to_bits), n.map(f32::to_bits), "{d:?}");
+                    let [x, y, z] = *d;
+                    let [nx, ny, nz] = unit([z, y, x]);
+                    assert_eq!([nz, ny, nx].map(f32::to_bits), n.map(f32::to_bits), "{d:?}");
+                    let length = squared(*n).sqrt();
+                    assert!((length - 1.0).abs() < 1e-6, "{n:?} from {d:?}");
+                }
+            }
+        }
+    }
+
     /// The normal a vertex pass gives the edge from `p` along `AXIS`, a third of the way along
     /// (samples 1 and −2, level 0).
     fn normal<const AXIS: usize>(field: &Field<'_, f64>, p: [usize; 3]) -> Option<[f32; 3]> {
         (p[AXIS] + 1 < field.dims[AXIS]).then(|| {
             let plane = field.interior_plane::<AXIS>(p[2], true);
             let row = plane.as_ref().and_then(|plane| plane.row(p[1]));
-            field.normal::<AXIS>(row, p, (1.0, -2.0), 0.0)
+            field.normal::<AXIS>(row, p, (1.0, -2.0), 0.0).unit()
         })
     }
 

@@ -122,9 +122,34 @@ fn thread_count_streaming_and_scratch_do_not_change_the_mesh() {
     all_entry_points_agree(&integer_noise([20, 17, 33], 3, 1), "integer ties");
     all_entry_points_agree(&brainsmall_crop(), "brainsmall crop");
     all_entry_points_agree(&stent_crop(250.0), "stent crop");
+    all_entry_points_agree(&half_huge(), "half at 1e25");
     // Fewer layers than threads, and a single layer.
     all_entry_points_agree(&integer_noise([9, 9, 3], 3, 2), "3 slices");
     all_entry_points_agree(&integer_noise([9, 9, 2], 3, 3), "2 slices");
+}
+
+/// The noisy sphere with level 0, its samples for `x` below the middle scaled by 1e25: the same
+/// surface, whose gradients there have squared lengths past `f32`'s range. Those normals come in
+/// `f64`, already of unit length, among the others that sinks which keep their normals scale a
+/// layer at a time (`Sink::edge_vertex_toward`), so every entry point's mesh must still agree,
+/// and every normal must have unit length.
+fn half_huge() -> Vol<f64> {
+    let mut vol = volumes::demo(demo::sphere_noise(40));
+    let nx = vol.dims[0];
+    for (i, v) in vol.data.iter_mut().enumerate() {
+        *v = (*v - vol.iso) * if i % nx < nx / 2 { 1e25 } else { 1.0 };
+    }
+    vol.iso = 0.0;
+    let params = Params {
+        normals: true,
+        ..vol.params(Mode::Embedded)
+    };
+    let mesh = extract(&Volume::new(&vol.data, vol.dims).expect("valid"), &params).expect("mesh");
+    for n in &mesh.normals {
+        let length = n.iter().map(|c| f64::from(*c).powi(2)).sum::<f64>().sqrt();
+        assert!((length - 1.0).abs() < 1e-6, "{n:?}");
+    }
+    vol
 }
 
 /// Records each vertex's grid edge and value, as the sweep hands them over.
