@@ -115,3 +115,52 @@ impl Unsettled {
         self.0 += 1;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Unsettled;
+    use crate::vertex::unit;
+    use alloc::vec::Vec;
+
+    /// Settling scales exactly the normals sent since the last settling, wherever the split
+    /// between a stretch's slots and its spill falls, before, at or after where they start; a
+    /// unit normal stepped over stays as it was.
+    #[test]
+    fn settling_scales_each_unsettled_normal_once() {
+        let directions: Vec<[f32; 3]> = (1..=11u8)
+            .map(|i| [f32::from(i), f32::from(i % 3) - 1.0, 0.5 * f32::from(i % 5)])
+            .collect();
+        let scaled: Vec<[f32; 3]> = directions.iter().map(|&d| unit(d)).collect();
+        // Of length 13: settled, it changes; stepped over as a unit normal, it stays.
+        let kept = [3.0, 4.0, 12.0];
+        for from in 0..=directions.len() {
+            for split in 0..=directions.len() + 1 {
+                let mut normals = directions.clone();
+                normals[..from].copy_from_slice(&scaled[..from]);
+                normals.push(kept);
+                let split = split.min(normals.len());
+                let (head, tail) = normals.split_at_mut(split);
+                let mut unsettled = Unsettled::from(from);
+                unsettled.settle(head, tail);
+                assert_eq!(
+                    normals[..directions.len()],
+                    scaled[..],
+                    "from {from}, split {split}"
+                );
+                assert_ne!(normals[directions.len()], kept);
+                // The same, with the last normal stepped over as a unit normal.
+                let mut normals = directions.clone();
+                normals[..from].copy_from_slice(&scaled[..from]);
+                let mut unsettled = Unsettled::from(from);
+                let len = normals.len();
+                let (head, tail) = normals.split_at_mut(split.min(len));
+                unsettled.before_unit(head, tail);
+                normals.push(kept);
+                let (head, tail) = normals.split_at_mut(split.min(len + 1));
+                unsettled.settle(head, tail);
+                assert_eq!(normals[..len], scaled[..], "from {from}, split {split}");
+                assert_eq!(normals[len], kept, "from {from}, split {split}");
+            }
+        }
+    }
+}
