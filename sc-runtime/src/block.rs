@@ -140,12 +140,11 @@ impl Sink for Collect {
         position: [f32; 3],
         normal: Option<[f32; 3]>,
     ) {
-        if normal.is_some() {
-            self.unsettled.before_unit(&mut self.normals, &mut []);
-        }
         self.keys.push(edge_key(self.grid, lower, axis));
         self.positions.push(position);
-        self.normals.extend(normal);
+        if let Some(n) = normal {
+            self.unsettled.push_unit(&mut self.normals, n);
+        }
     }
 
     fn edge_vertex_toward(
@@ -161,7 +160,7 @@ impl Sink for Collect {
     }
 
     fn settle_normals(&mut self) {
-        self.unsettled.settle(&mut self.normals, &mut []);
+        self.unsettled.settle(&mut self.normals);
     }
 
     fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {

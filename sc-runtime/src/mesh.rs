@@ -163,10 +163,10 @@ impl<'m> Presized<'m> {
 impl Sink for Presized<'_> {
     #[inline]
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
-        if normal.is_some() {
-            self.unsettled.before_unit(&mut self.mesh.normals, &mut []);
+        self.mesh.positions.push(position);
+        if let Some(n) = normal {
+            self.unsettled.push_unit(&mut self.mesh.normals, n);
         }
-        self.mesh.vertex(position, normal);
     }
 
     #[inline]
@@ -181,7 +181,7 @@ impl Sink for Presized<'_> {
     }
 
     fn settle_normals(&mut self) {
-        self.unsettled.settle(&mut self.mesh.normals, &mut []);
+        self.unsettled.settle(&mut self.mesh.normals);
     }
 
     #[inline]

@@ -36,9 +36,7 @@ impl Sink for Region<'_> {
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
         self.positions.push(position);
         if let Some(n) = normal {
-            let (head, tail) = self.normals.written_mut();
-            self.unsettled.before_unit(head, tail);
-            self.normals.push(n);
+            self.unsettled.push_unit(&mut self.normals, n);
         }
     }
 
@@ -55,8 +53,7 @@ impl Sink for Region<'_> {
     }
 
     fn settle_normals(&mut self) {
-        let (head, tail) = self.normals.written_mut();
-        self.unsettled.settle(head, tail);
+        self.unsettled.settle(&mut self.normals);
     }
 }
 

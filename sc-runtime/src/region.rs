@@ -17,6 +17,7 @@ use rayon::prelude::*;
 #[cfg(doc)]
 use crate::Mesh;
 use crate::mesh::{PushIf, huge_pages};
+use crate::sink::NormalColumn;
 
 /// A chunk's stretch of a shared vector: pushes go to the stretch until it is full, then to a
 /// vector of the chunk's own (the survey fell short, which the join handles by copying).
@@ -37,14 +38,6 @@ impl<T> Stretch<'_, T> {
             }
             None => self.spill.push(value),
         }
-    }
-
-    /// The elements pushed, in order: those in the stretch's slots, then those spilled.
-    pub fn written_mut(&mut self) -> (&mut [T], &mut [T]) {
-        let head: *mut [MaybeUninit<T>] = &mut self.slots[..self.len];
-        // SAFETY: pushes wrote the first `len` slots (a slot written but not kept lies past
-        // them), and `MaybeUninit<T>` has `T`'s layout.
-        (unsafe { &mut *(head as *mut [T]) }, &mut self.spill)
     }
 
     /// Elements pushed.
@@ -74,6 +67,21 @@ impl<T> Stretch<'_, T> {
             len: self.len,
             spill: self.spill,
         }
+    }
+}
+
+impl NormalColumn for Stretch<'_, [f32; 3]> {
+    #[inline]
+    fn push(&mut self, normal: [f32; 3]) {
+        Stretch::push(self, normal);
+    }
+
+    /// Those in the stretch's slots, then those spilled.
+    fn written_mut(&mut self) -> (&mut [[f32; 3]], &mut [[f32; 3]]) {
+        let head: *mut [MaybeUninit<[f32; 3]>] = &mut self.slots[..self.len];
+        // SAFETY: pushes wrote the first `len` slots (a slot written but not kept lies past
+        // them), and `MaybeUninit<T>` has `T`'s layout.
+        (unsafe { &mut *(head as *mut [[f32; 3]]) }, &mut self.spill)
     }
 }
 

@@ -80,10 +80,30 @@ pub trait Sink {
     }
 }
 
+/// A keeping sink's normals (the mesh's vector, a block's collection, a parallel chunk's
+/// stretch), as [`Unsettled`] reads and extends them.
+#[cfg(feature = "alloc")]
+pub(crate) trait NormalColumn {
+    fn push(&mut self, normal: [f32; 3]);
+    /// The normals pushed, in order, in up to two slices (a stretch's slots, then what it
+    /// spilled).
+    fn written_mut(&mut self) -> (&mut [[f32; 3]], &mut [[f32; 3]]);
+}
+
+#[cfg(feature = "alloc")]
+impl NormalColumn for alloc::vec::Vec<[f32; 3]> {
+    #[inline]
+    fn push(&mut self, normal: [f32; 3]) {
+        self.push(normal);
+    }
+
+    fn written_mut(&mut self) -> (&mut [[f32; 3]], &mut [[f32; 3]]) {
+        (self, &mut [])
+    }
+}
+
 /// Where the normals a sink keeps stop being unit vectors: those sent by
-/// [`Sink::edge_vertex_toward`] since the sink last settled them. Each keeping sink (the mesh's
-/// vectors, a parallel chunk's stretches, a block's collection) has its normals in order in up
-/// to two slices, `head` then `tail` (a stretch's slots, then what it spilled).
+/// [`Sink::edge_vertex_toward`] since the sink last settled them.
 #[cfg(feature = "alloc")]
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Unsettled(usize);
@@ -95,8 +115,10 @@ impl Unsettled {
         Unsettled(from)
     }
 
-    /// Scales the unsettled normals to unit length ([`units`]); all are settled after.
-    pub fn settle(&mut self, head: &mut [[f32; 3]], tail: &mut [[f32; 3]]) {
+    /// Scales the unsettled normals of `normals` to unit length ([`units`]); all are settled
+    /// after.
+    pub fn settle(&mut self, normals: &mut impl NormalColumn) {
+        let (head, tail) = normals.written_mut();
         let total = head.len() + tail.len();
         match self.0.checked_sub(head.len()) {
             None => {
@@ -108,58 +130,83 @@ impl Unsettled {
         self.0 = total;
     }
 
-    /// Settles the normals so far, and steps over the next: a unit normal (from
-    /// [`Sink::vertex`] or [`Sink::edge_vertex`]) that the sink is about to keep.
-    pub fn before_unit(&mut self, head: &mut [[f32; 3]], tail: &mut [[f32; 3]]) {
-        self.settle(head, tail);
+    /// Pushes a normal already of unit length (from [`Sink::vertex`] or [`Sink::edge_vertex`]):
+    /// the normals before it are settled first, and it is stepped over. Out of line: the sweep
+    /// sends few such normals, and inlined into the vertex passes this took 7 % more time.
+    #[cold]
+    #[inline(never)]
+    pub fn push_unit(&mut self, normals: &mut impl NormalColumn, normal: [f32; 3]) {
+        self.settle(normals);
+        normals.push(normal);
         self.0 += 1;
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::Unsettled;
+    use super::{NormalColumn, Unsettled};
     use crate::vertex::unit;
     use alloc::vec::Vec;
 
+    /// Normals in two slices split at `at` (or at the end, if shorter), as a stretch holds its
+    /// slots and its spill.
+    struct Split {
+        normals: Vec<[f32; 3]>,
+        at: usize,
+    }
+
+    impl NormalColumn for Split {
+        fn push(&mut self, normal: [f32; 3]) {
+            self.normals.push(normal);
+        }
+
+        fn written_mut(&mut self) -> (&mut [[f32; 3]], &mut [[f32; 3]]) {
+            let at = self.at.min(self.normals.len());
+            self.normals.split_at_mut(at)
+        }
+    }
+
     /// Settling scales exactly the normals sent since the last settling, wherever the split
     /// between a stretch's slots and its spill falls, before, at or after where they start; a
-    /// unit normal stepped over stays as it was.
+    /// unit normal pushed as one stays as it was.
     #[test]
     fn settling_scales_each_unsettled_normal_once() {
         let directions: Vec<[f32; 3]> = (1..=11u8)
             .map(|i| [f32::from(i), f32::from(i % 3) - 1.0, 0.5 * f32::from(i % 5)])
             .collect();
         let scaled: Vec<[f32; 3]> = directions.iter().map(|&d| unit(d)).collect();
-        // Of length 13: settled, it changes; stepped over as a unit normal, it stays.
+        // Of length 13: settled, it changes; pushed as a unit normal, it stays.
         let kept = [3.0, 4.0, 12.0];
-        for from in 0..=directions.len() {
-            for split in 0..=directions.len() + 1 {
+        let len = directions.len();
+        for from in 0..=len {
+            for split in 0..=len + 1 {
                 let mut normals = directions.clone();
                 normals[..from].copy_from_slice(&scaled[..from]);
-                normals.push(kept);
-                let split = split.min(normals.len());
-                let (head, tail) = normals.split_at_mut(split);
+                let column = |normals: &Vec<[f32; 3]>| Split {
+                    normals: normals.clone(),
+                    at: split,
+                };
+                let mut pushed = column(&normals);
+                pushed.normals.push(kept);
                 let mut unsettled = Unsettled::from(from);
-                unsettled.settle(head, tail);
+                unsettled.settle(&mut pushed);
                 assert_eq!(
-                    normals[..directions.len()],
+                    pushed.normals[..len],
                     scaled[..],
                     "from {from}, split {split}"
                 );
-                assert_ne!(normals[directions.len()], kept);
-                // The same, with the last normal stepped over as a unit normal.
-                let mut normals = directions.clone();
-                normals[..from].copy_from_slice(&scaled[..from]);
+                assert_ne!(pushed.normals[len], kept);
+                // The same, with the last normal pushed as a unit normal.
+                let mut pushed = column(&normals);
                 let mut unsettled = Unsettled::from(from);
-                let len = normals.len();
-                let (head, tail) = normals.split_at_mut(split.min(len));
-                unsettled.before_unit(head, tail);
-                normals.push(kept);
-                let (head, tail) = normals.split_at_mut(split.min(len + 1));
-                unsettled.settle(head, tail);
-                assert_eq!(normals[..len], scaled[..], "from {from}, split {split}");
-                assert_eq!(normals[len], kept, "from {from}, split {split}");
+                unsettled.push_unit(&mut pushed, kept);
+                unsettled.settle(&mut pushed);
+                assert_eq!(
+                    pushed.normals[..len],
+                    scaled[..],
+                    "from {from}, split {split}"
+                );
+                assert_eq!(pushed.normals[len], kept, "from {from}, split {split}");
             }
         }
     }
