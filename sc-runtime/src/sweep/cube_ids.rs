@@ -9,9 +9,11 @@ pub(super) struct CubeIds<'a> {
     ids: &'a [u32],
     /// The merge marks, a byte per cube (`Out::merged`), at least `cubes` of them.
     marks: &'a [u8],
-    /// Sixteen entries, so that an edge number masked with 15 needs no test. Each offset is
-    /// followed by at least `cubes` ids ([`CubeIds::new`] makes sure).
-    edge_at: [usize; 16],
+    /// By a byte's worth of edge numbers, so that an edge read from the tables needs neither a
+    /// test nor a mask: each edge's offset at its number and again 16, 32, … further on, where
+    /// [`Entry::merge`](crate::tables::Entry::merge)'s flags put it. Each offset is followed by
+    /// at least `cubes` ids ([`CubeIds::new`] makes sure).
+    edge_at: [usize; 256],
     /// `nx · ny − nx − 1`: every cube's `i + nx · j` (`i < nx − 1`, `j < ny − 1`) is below it.
     cubes: usize,
 }
@@ -25,8 +27,8 @@ impl<'a> CubeIds<'a> {
         let plane = nx * ny;
         let cubes = plane.saturating_sub(nx + 1);
         let (lo, hi) = (k % 2, (k + 1) % 2);
-        let edge_at: [usize; 16] = core::array::from_fn(|e| {
-            let r = e % 4;
+        let edge_at: [usize; 256] = core::array::from_fn(|e| {
+            let (e, r) = (e % 16, e % 4);
             let (a, b) = (r & 1, r >> 1);
             match e / 4 {
                 0 => [lo, hi][b] * 2 * plane + a * nx,
@@ -70,10 +72,13 @@ impl Cube<'_, '_> {
     #[inline(always)]
     pub fn id(&self, edge: u8) -> u32 {
         let CubeIds { ids, edge_at, .. } = self.ids;
-        let i = edge_at[usize::from(edge & 15)] + self.at;
         // SAFETY: `at < cubes` (`CubeIds::cube`) and every offset is at most
-        // `ids.len() − cubes` (`CubeIds::new`), so `i < ids.len()`.
-        unsafe { *ids.get_unchecked(i) }
+        // `ids.len() − cubes` (`CubeIds::new`), so `at + offset < ids.len()`. Offset from the
+        // cube's own ids, whose address the compiler computes once for all the cube's reads.
+        unsafe {
+            *ids.get_unchecked(self.at..)
+                .get_unchecked(edge_at[usize::from(edge)])
+        }
     }
 
     /// The cube's merge marks.
@@ -88,6 +93,6 @@ impl Cube<'_, '_> {
     #[inline(always)]
     pub fn next_id(&self, step: usize, edge: u8) -> u32 {
         let CubeIds { ids, edge_at, .. } = self.ids;
-        ids[edge_at[usize::from(edge & 15)] + self.at + step]
+        ids[edge_at[usize::from(edge)] + self.at + step]
     }
 }
