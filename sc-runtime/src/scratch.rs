@@ -23,7 +23,7 @@ pub struct ScratchLen {
 pub(crate) const BYTE_PLANES: usize = 8;
 /// Bytes after the classified slices and after the cube cases: a row's last sixteen-byte block is
 /// read whole and masked to the row, so that no row needs a byte-by-byte tail loop.
-pub(crate) const PAD: usize = 16;
+pub(crate) const PAD: usize = 64;
 /// Two planes of x- and y-edge vertex ids plus one layer of z-edge ids.
 pub(crate) const WORD_PLANES: usize = 5;
 /// Span pairs per row: four classified slices and three case layers.

@@ -962,41 +962,54 @@ fn union_span<const N: usize>(spans: [Span; N], nx: usize) -> (usize, usize) {
 }
 
 /// Calls `f(x, case)` for each `x` in `start..end`, in order, whose cube the surface crosses (its
-/// case is neither 0 nor 255). Tests sixteen cases at a time: most of a row's span lies wholly
+/// case is neither 0 nor 255). Tests a block of cases at a time: most of a row's span lies wholly
 /// inside or outside the surface (seven in eight cubes of brainsmall's spans), and the crossed
 /// cubes of a block are then taken from its mask, each case from the block itself, so that a
-/// crossed cube costs no second load. `cases` runs at least fifteen bytes past `end` (see
-/// [`lanes`]).
+/// crossed cube costs no second load. `cases` runs at least `SCAN − 1` bytes past `end` (see
+/// [`in_span`]).
 #[inline(always)]
 fn for_each_crossed(cases: &[u8], start: usize, end: usize, mut f: impl FnMut(usize, u8)) {
     let mut x = start;
     while x < end {
-        let block: [u8; LANES] = cases[x..x + LANES].try_into().expect("sixteen bytes");
-        let v = u8x16::new(block);
-        let trivial = v.simd_eq(u8x16::splat(0)) | v.simd_eq(u8x16::splat(255));
-        let mut crossed = !trivial.to_bitmask() & lanes(end - x);
+        let block: &[u8; SCAN] = cases[x..x + SCAN].try_into().expect("a scan block");
+        let trivial = mask(|r| {
+            let v = load(&block[LANES * r..]);
+            v.simd_eq(u8x16::splat(0)) | v.simd_eq(u8x16::splat(255))
+        });
+        let mut crossed = !trivial & in_span(end - x);
         while crossed != 0 {
             let n = crossed.trailing_zeros() as usize;
-            f(x + n, block[n % LANES]);
+            f(x + n, block[n % SCAN]);
             crossed &= crossed - 1;
         }
-        x += LANES;
+        x += SCAN;
     }
 }
 
-/// Bytes per block of the row scans: one SSE2 or NEON register, whose compare gives a bit mask
-/// of the block (`to_bitmask`), so that a scan walks the mask's bits straight to the bytes it
-/// wants. Eight-byte words, which needed a shift and a mask per byte found, took 7–10 % more
-/// instructions over the whole sweep.
+/// Bytes per register: one SSE2 or NEON compare gives a bit mask of sixteen bytes
+/// (`to_bitmask`), so that a scan walks the mask's bits straight to the bytes it wants. Eight-byte
+/// words, which needed a shift and a mask per byte found, took 7–10 % more instructions over the
+/// whole sweep.
 const LANES: usize = 16;
 
-/// The bit mask of a block's first `left` bytes (all of them from 16 up). Rows are read a whole
-/// block at a time, past their end into padding or the next row, and the mask keeps what lies
-/// within: a byte-by-byte loop over the last few bytes of each row cost about 2 % of brainsmall's
-/// instructions.
+/// Bytes per block of the row scans: four registers' masks in one word. The loop over a block's
+/// bits mispredicts its exit about once per block with something in it, and a surface's
+/// crossings in a row cluster where it enters and leaves: wider blocks, fewer exits.
+const SCAN: usize = 4 * LANES;
+
+/// The bit mask of a block's first `left` bytes (all of them from `SCAN` up). Rows are read a
+/// whole block at a time, past their end into padding or the next row, and the mask keeps what
+/// lies within: a byte-by-byte loop over the last few bytes of each row cost about 2 % of
+/// brainsmall's instructions.
 #[inline(always)]
-fn lanes(left: usize) -> u32 {
-    u32::MAX >> (32 - LANES.min(left))
+fn in_span(left: usize) -> u64 {
+    u64::MAX >> (64 - SCAN.min(left))
+}
+
+/// A scan block's bit mask from its registers' compares: `test(r)` for bytes `16 · r ..`.
+#[inline(always)]
+fn mask(test: impl Fn(usize) -> u8x16) -> u64 {
+    (0..SCAN / LANES).fold(0, |m, r| m | u64::from(test(r).to_bitmask()) << (LANES * r))
 }
 
 /// Sixteen bytes from the start of `bytes`.
@@ -1049,15 +1062,16 @@ fn for_each_differing(
     mut f: impl FnMut(usize) -> Result<(), Error>,
 ) -> Result<(), Error> {
     // Whole blocks from slices cut to whole blocks once: no bounds check per block.
-    let blocks = (end.max(start) - start).div_ceil(LANES);
-    let (a, b) = (&a[start..][..LANES * blocks], &b[start..][..LANES * blocks]);
-    let mut scan = a.chunks_exact(LANES).zip(b.chunks_exact(LANES)).enumerate();
+    let blocks = (end.max(start) - start).div_ceil(SCAN);
+    let (a, b) = (&a[start..][..SCAN * blocks], &b[start..][..SCAN * blocks]);
+    let mut scan = a.as_chunks::<SCAN>().0.iter().zip(b.as_chunks::<SCAN>().0).enumerate();
     // Blocks without a difference are passed over in a loop of their own, whose few registers
     // `f` does not take: in one loop with `f`, every block reloaded the scan's state from the
     // stack.
-    let differing = |(w, (a, b)): (usize, (&[u8], &[u8]))| {
-        let diff = !load(a).simd_eq(load(b)).to_bitmask() & lanes(end - start - LANES * w);
-        (diff != 0).then_some((start + LANES * w, diff))
+    let differing = |(w, (a, b)): (usize, (&[u8; SCAN], &[u8; SCAN]))| {
+        let same = mask(|r| load(&a[LANES * r..]).simd_eq(load(&b[LANES * r..])));
+        let diff = !same & in_span(end - start - SCAN * w);
+        (diff != 0).then_some((start + SCAN * w, diff))
     };
     while let Some((x, mut diff)) = scan.find_map(differing) {
         while diff != 0 {
@@ -1100,21 +1114,21 @@ fn last_differing(row: &[u8], v: u8) -> Option<usize> {
 /// The bit mask of the bytes of a block that differ from `v`.
 #[inline(always)]
 fn differing(block: &[u8], v: u8) -> u32 {
-    !load(block).simd_eq(u8x16::splat(v)).to_bitmask() & lanes(LANES)
+    !load(block).simd_eq(u8x16::splat(v)).to_bitmask() & 0xFFFF
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{LANES, cube_cases, for_each_crossed, for_each_differing};
+    use super::{LANES, SCAN, cube_cases, for_each_crossed, for_each_differing};
     use alloc::vec;
     use alloc::vec::Vec;
 
     /// Rows mixing runs of 0 and 255 with crossed cases at every position of a block, each
-    /// followed by fifteen crossed bytes that the scans must not report.
+    /// followed by `SCAN − 1` crossed bytes that the scans must not report.
     fn rows() -> impl Iterator<Item = (Vec<u8>, usize)> {
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        (0..200).map(move |_| {
-            let mut row: Vec<u8> = (0..37)
+        (0..40).map(move |_| {
+            let mut row: Vec<u8> = (0..2 * SCAN + 11)
                 .map(|_| {
                     state = state
                         .wrapping_mul(6364136223846793005)
@@ -1128,7 +1142,7 @@ mod tests {
                 })
                 .collect();
             let len = row.len();
-            row.extend([7; 15]);
+            row.extend([7; SCAN - 1]);
             (row, len)
         })
     }
@@ -1191,7 +1205,7 @@ mod tests {
         let all: Vec<(Vec<u8>, usize)> = rows().collect();
         for pair in all.windows(2) {
             let ((a, len), (b, _)) = (&pair[0], &pair[1]);
-            let b: Vec<u8> = b[..*len].iter().chain(&[8; 15]).copied().collect();
+            let b: Vec<u8> = b[..*len].iter().chain(&[8; SCAN - 1]).copied().collect();
             for start in 0..*len {
                 for end in start..=*len {
                     let plain: Vec<usize> = (start..end).filter(|&x| a[x] != b[x]).collect();
