@@ -27,8 +27,8 @@ impl<'a> CubeIds<'a> {
         let plane = nx * ny;
         let cubes = plane.saturating_sub(nx + 1);
         let (lo, hi) = (k % 2, (k + 1) % 2);
-        let edge_at: [usize; 256] = core::array::from_fn(|e| {
-            let (e, r) = (e % 16, e % 4);
+        let edges: [usize; 16] = core::array::from_fn(|e| {
+            let r = e % 4;
             let (a, b) = (r & 1, r >> 1);
             match e / 4 {
                 0 => [lo, hi][b] * 2 * plane + a * nx,
@@ -40,8 +40,9 @@ impl<'a> CubeIds<'a> {
         // Holds for every layer: the largest offset is `4 · nx · ny + nx + 1`, `ids` holds five
         // planes and `marks` one. Tested once per layer, since the reads below rely on it.
         let room = ids.len().checked_sub(cubes);
+        let edge_at = core::array::from_fn(|e| edges[e % 16]);
         assert!(
-            room.is_some_and(|room| edge_at.iter().all(|&o| o <= room)) && marks.len() >= cubes,
+            room.is_some_and(|room| edges.iter().all(|&o| o <= room)) && marks.len() >= cubes,
             "the id planes and marks hold layer {k}'s cubes"
         );
         CubeIds {
