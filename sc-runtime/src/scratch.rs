@@ -21,8 +21,9 @@ pub struct ScratchLen {
 
 /// Four classified slices, three layers of cube cases and a plane of merge marks, a byte per cell.
 pub(crate) const BYTE_PLANES: usize = 8;
-/// Bytes after the classified slices and after the cube cases: a row's last sixteen-byte block is
-/// read whole and masked to the row, so that no row needs a byte-by-byte tail loop.
+/// Bytes after the classified slices and after the cube cases: a row's last scan block (64
+/// bytes, `sweep::SCAN`) is read whole and masked to the row, so that no row needs a
+/// byte-by-byte tail loop.
 pub(crate) const PAD: usize = 64;
 /// Two planes of x- and y-edge vertex ids plus one layer of z-edge ids.
 pub(crate) const WORD_PLANES: usize = 5;

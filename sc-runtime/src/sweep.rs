@@ -996,6 +996,10 @@ const LANES: usize = 16;
 /// bits mispredicts its exit about once per block with something in it, and a surface's
 /// crossings in a row cluster where it enters and leaves: wider blocks, fewer exits.
 const SCAN: usize = 4 * LANES;
+const _: () = assert!(
+    SCAN <= PAD,
+    "a scan block past a row's end stays in the scratch"
+);
 
 /// The bit mask of a block's first `left` bytes (all of them from `SCAN` up). Rows are read a
 /// whole block at a time, past their end into padding or the next row, and the mask keeps what
@@ -1050,7 +1054,7 @@ fn cube_cases(rows: [&[u8]; 4], out: &mut [u8], len: usize) {
 
 /// Calls `f(x)` for each `x` in `start..end`, in order, where `a[x] != b[x]`, comparing a block
 /// of bytes at a time: most of a row's span is unchanged, and a vertex is the rare event. Both
-/// slices run at least fifteen bytes past `end`: the last block is read whole and masked, so that
+/// slices run at least `SCAN − 1` bytes past `end`: the last block is read whole and masked, so that
 /// `f` has one call site and is inlined (called out of line, once per vertex, it cost a fifth of
 /// the vertex passes).
 #[inline]
@@ -1064,7 +1068,12 @@ fn for_each_differing(
     // Whole blocks from slices cut to whole blocks once: no bounds check per block.
     let blocks = (end.max(start) - start).div_ceil(SCAN);
     let (a, b) = (&a[start..][..SCAN * blocks], &b[start..][..SCAN * blocks]);
-    let mut scan = a.as_chunks::<SCAN>().0.iter().zip(b.as_chunks::<SCAN>().0).enumerate();
+    let mut scan = a
+        .as_chunks::<SCAN>()
+        .0
+        .iter()
+        .zip(b.as_chunks::<SCAN>().0)
+        .enumerate();
     // Blocks without a difference are passed over in a loop of their own, whose few registers
     // `f` does not take: in one loop with `f`, every block reloaded the scan's state from the
     // stack.
