@@ -3,6 +3,9 @@
 //! mode given. `--python` adds the values and the `(z, y, x)` coordinates that the Python
 //! package's `marching_cubes` asks for: the sweep's copy for that output is compiled apart, and
 //! a change can speed one copy and not the other (see `docs/speed-log.md`, after `b78d4f4`).
+//! `--reuse` extracts through one [`Extractor`] (one thread), which keeps its mesh's memory
+//! between runs: against the default, where each run's mesh is fresh memory while the last
+//! run's is still held, it shows what first touching the output's pages costs.
 //! Under `valgrind --tool=callgrind` pass `RUNS` = 1: instruction counts, unlike seconds, do not
 //! move with the machine's load.
 //!
@@ -14,13 +17,13 @@
 
 use std::time::Instant;
 
-use sc_runtime::{Axes, Mode, Params, Scalar, Volume, extract_par};
+use sc_runtime::{Axes, Extractor, Mode, Params, Scalar, Volume, extract_par};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let [_, path, dims, dtype, iso, runs, modes, rest @ ..] = args.as_slice() else {
         return Err(
-            "usage: time_extract VOLUME.raw NX,NY,NZ DTYPE ISO RUNS MODE[,MODE…] [--normals] [--python] [--threads N]"
+            "usage: time_extract VOLUME.raw NX,NY,NZ DTYPE ISO RUNS MODE[,MODE…] [--normals] [--python] [--threads N | --reuse]"
                 .into(),
         );
     };
@@ -32,6 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         runs: runs.parse()?,
         normals: rest.iter().any(|a| a == "--normals"),
         python: rest.iter().any(|a| a == "--python"),
+        reuse: rest.iter().any(|a| a == "--reuse"),
         threads: rest
             .iter()
             .position(|a| a == "--threads")
@@ -79,6 +83,8 @@ struct Options {
     /// Values and `(z, y, x)` coordinates, as the Python package's `marching_cubes` asks.
     python: bool,
     threads: usize,
+    /// Through one `Extractor`, whose mesh keeps its memory from run to run.
+    reuse: bool,
 }
 
 fn time<T: Scalar>(
@@ -97,14 +103,21 @@ fn time<T: Scalar>(
     };
     let mut times = Vec::with_capacity(options.runs);
     let mut mesh = None;
+    let mut extractor = Extractor::new();
     for _ in 0..options.runs.max(1) {
         let t = Instant::now();
-        let m = extract_par(&vol, &params, options.threads, &|_| {})?;
+        // The last run's mesh is dropped after the clock stops.
+        let fresh = if options.reuse {
+            extractor.extract(&vol, &params)?;
+            None
+        } else {
+            Some(extract_par(&vol, &params, options.threads, &|_| {})?)
+        };
         times.push(t.elapsed().as_secs_f64() * 1e3);
-        mesh = Some(m);
+        mesh = fresh;
     }
     times.sort_by(f64::total_cmp);
-    let mesh = mesh.expect("at least one run");
+    let mesh = mesh.unwrap_or_else(|| extractor.into_mesh());
     Ok(Timing {
         median: times[times.len() / 2],
         fastest: times[0],
