@@ -38,10 +38,14 @@ import skelclimb  # noqa: E402
 DTYPES = dict(DTYPES, f32=np.float32, f64=np.float64, i8=np.int8, u32=np.uint32, i32=np.int32)
 
 
-def volumes(data_dir):
+def volumes(data_dir, only=()):
+    """(label, array, iso) of every volume, or of those whose label starts with one of ``only``:
+    a built-in volume takes seconds to make, so only those asked for are made."""
+    wanted = lambda label: not only or any(label.startswith(o) for o in only)  # noqa: E731
     for name, (make, iso) in BUILTIN.items():
-        yield name, make(256).astype(np.float32), iso
-    yield from data_volumes(data_dir)
+        if wanted(name):
+            yield name, make(256).astype(np.float32), iso
+    yield from (v for v in data_volumes(data_dir) if wanted(v[0]))
 
 
 def data_volumes(data_dir):
@@ -138,8 +142,7 @@ def main():
     print(f"scikit-image {skimage.__version__}, VTK {vtk.vtkVersion.GetVTKVersion()}, "
           f"zmesh {importlib.metadata.version('zmesh')}\n")
     names = list(PEERS)
-    chosen = [(label, vol, iso) for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR"))
-              if not a.only or any(label.startswith(o) for o in a.only)]
+    chosen = list(volumes(os.environ.get("SC_DATA_DIR"), a.only))
     # Each round times every mesher on every volume, one after the other: the two sides of a
     # ratio are seconds apart, and a drift of the machine's speed shows as a spread of the
     # rounds' ratios rather than as one volume's outlier.

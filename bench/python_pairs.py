@@ -35,9 +35,7 @@ def main():
         ap.error("--pairs must be at least 1")
     print(f"| volume | ratio (middle half) | {PAIR[0]} ms | {PAIR[1]} ms | fastest calls' ratio |")
     print("|---|---|---|---|---|")
-    for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR")):
-        if a.only and not any(label.startswith(p) for p in a.only):
-            continue
+    for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR"), a.only or ()):
         calls = [PEERS[name] for name in PAIR]
         for call in calls:
             call(vol, iso)

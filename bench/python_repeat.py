@@ -27,7 +27,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from python_compare import data_volumes  # noqa: E402  (the same volumes and iso values)
+from python_compare import volumes  # noqa: E402  (the same volumes and iso values)
 
 import numpy as np  # noqa: E402
 import skimage.measure  # noqa: E402
@@ -46,7 +46,8 @@ def main():
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--calls", type=int, default=21)
     ap.add_argument("--only", nargs="*", default=DEFAULT,
-                    help="volume labels (prefixes), as bench/python_compare.py names them")
+                    help="volume labels (prefixes), as bench/python_compare.py names them; "
+                         "the built-in ones too (noise-256, ...)")
     ap.add_argument("--extract", action="store_true",
                     help="call extract (normals on) instead of marching_cubes")
     ap.add_argument("--faults", action="store_true",
@@ -55,9 +56,7 @@ def main():
                     help="before each call, untimed: nothing, a NumPy pass writing 96 MB, or "
                          "scikit-image's marching_cubes on the same volume")
     a = ap.parse_args()
-    for label, volume, iso in data_volumes(os.environ.get("SC_DATA_DIR")):
-        if not any(label.startswith(p) for p in a.only):
-            continue
+    for label, volume, iso in volumes(os.environ.get("SC_DATA_DIR"), a.only):
         if a.extract:
             call = lambda: skelclimb.extract(volume, iso, threads=a.threads)  # noqa: E731
         else:
