@@ -29,13 +29,13 @@ PAIR = ("skelclimb", "scikit-image")
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--pairs", type=int, default=40)
-    ap.add_argument("--only", nargs="*", help="volume labels (prefixes) to run")
+    ap.add_argument("--only", nargs="*", default=[], help="volume labels (prefixes) to run")
     a = ap.parse_args()
     if a.pairs < 1:
         ap.error("--pairs must be at least 1")
     print(f"| volume | ratio (middle half) | {PAIR[0]} ms | {PAIR[1]} ms | fastest calls' ratio |")
     print("|---|---|---|---|---|")
-    for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR"), a.only or ()):
+    for label, vol, iso in volumes(os.environ.get("SC_DATA_DIR"), a.only):
         calls = [PEERS[name] for name in PAIR]
         for call in calls:
             call(vol, iso)
