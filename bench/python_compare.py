@@ -41,7 +41,9 @@ DTYPES = dict(DTYPES, f32=np.float32, f64=np.float64, i8=np.int8, u32=np.uint32,
 def volumes(data_dir, only=()):
     """(label, array, iso) of every volume, or of those whose label starts with one of ``only``:
     a built-in volume takes seconds to make, so only those asked for are made."""
-    wanted = lambda label: not only or any(label.startswith(o) for o in only)  # noqa: E731
+    def wanted(label):
+        return not only or any(label.startswith(o) for o in only)
+
     for name, (make, iso) in BUILTIN.items():
         if wanted(name):
             yield name, make(256).astype(np.float32), iso
