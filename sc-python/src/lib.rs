@@ -7,11 +7,22 @@ mod convert;
 mod errors;
 mod extract;
 mod files;
+mod recycle;
 mod shards;
 mod skimage;
 mod streamer;
 
 use pyo3::prelude::*;
+
+#[global_allocator]
+static ALLOCATOR: recycle::Recycling = recycle::Recycling;
+
+/// Frees the memory of dropped meshes that skelclimb keeps for its next call, and returns how
+/// many bytes that was.
+#[pyfunction]
+fn release_memory() -> usize {
+    recycle::release()
+}
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -25,6 +36,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shards::write_shard, m)?)?;
     m.add_function(wrap_pyfunction!(shards::write_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(shards::merge_shards, m)?)?;
+    m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_class::<streamer::SliceStreamer>()?;
     Ok(())
 }

@@ -315,6 +315,40 @@ def test_the_gil_is_released_during_extraction():
     assert during > 0.3 * rate * elapsed, (during, rate, elapsed)
 
 
+# ---- the memory of dropped meshes ----
+
+
+def _addresses(mesh):
+    return {a.__array_interface__["data"][0] for a in (mesh.vertices, mesh.faces, mesh.normals)}
+
+
+def test_a_dropped_meshs_memory_is_what_the_next_call_writes():
+    vol = np.random.default_rng(2).random((96, 96, 96), dtype=np.float32)
+    skelclimb.release_memory()
+    first = skelclimb.extract(vol, 0.5)
+    sizes = [a.nbytes for a in (first.vertices, first.faces, first.normals)]
+    assert min(sizes) >= 4 << 20, sizes
+    held = _addresses(first)
+    del first
+    second = skelclimb.extract(vol, 0.5)
+    assert _addresses(second) == held
+    del second
+    # The blocks' sizes are the vectors' capacities, which may exceed the arrays' lengths.
+    assert skelclimb.release_memory() >= sum(sizes)
+    assert skelclimb.release_memory() == 0
+
+
+def test_the_memory_kept_is_capped():
+    vol = np.random.default_rng(3).random((150, 150, 150), dtype=np.float32)
+    skelclimb.release_memory()
+    meshes = [skelclimb.extract(vol, 0.5) for _ in range(3)]
+    dropped = sum(a.nbytes for m in meshes for a in (m.vertices, m.faces, m.normals))
+    assert dropped > 256 << 20, dropped
+    del meshes
+    kept = skelclimb.release_memory()
+    assert 0 < kept <= 256 << 20, kept
+
+
 # ---- load and the streamer ----
 
 
