@@ -22,8 +22,9 @@ const LARGE: usize = 4 << 20;
 const CAP: usize = 256 << 20;
 /// The most blocks it holds: a mesh has four arrays, a call's scratch two more.
 const SLOTS: usize = 8;
-/// The alignment `malloc` guarantees on the 64-bit platforms the wheels are built for.
-const MALLOC_ALIGN: usize = 16;
+/// The alignment `malloc` guarantees: twice a pointer's size (16 bytes on 64-bit platforms), as
+/// `System` assumes too.
+const MALLOC_ALIGN: usize = 2 * core::mem::size_of::<usize>();
 
 /// Freed blocks, as `(address, size)`; a size of 0 marks an empty slot. Allocations only try
 /// the lock and go to `malloc` and `free` when another thread holds it: they never wait, not even
