@@ -9,6 +9,7 @@ otherwise. Usage: .ci/check-links.py [FILE.md ...] (by default README.md and doc
 repository's root).
 """
 
+import os
 import re
 import sys
 from pathlib import Path
@@ -23,6 +24,11 @@ INLINE = re.compile(r"!?\[(?:[^\[\]]|\[[^\[\]]*\])*\]\(\s*<?([^)\s>]*)>?(?:\s+\"
 REFERENCE = re.compile(r"^\s{0,3}\[[^\]]+\]:\s*<?(\S+?)>?(?:\s+.*)?$")
 HTML_ID = re.compile(r"""<a\s+(?:name|id)=["']([^"']+)["']""", re.IGNORECASE)
 URL = re.compile(r"^[a-zA-Z][a-zA-Z0-9+.-]*:")
+
+
+def shown(path: Path) -> str:
+    """The path as the messages show it: relative to the current folder."""
+    return os.path.relpath(path)
 
 
 def slug(heading: str) -> str:
@@ -79,11 +85,11 @@ def check(path: Path, cache: dict) -> list:
                 continue
             file_part, _, anchor = target.partition("#")
             dest = (path.parent / file_part).resolve() if file_part else path
-            where = f"{path.relative_to(ROOT)}:{number}: {target}"
+            where = f"{shown(path)}:{number}: {target}"
             if not dest.exists():
                 problems.append(f"{where}: no such file or folder")
             elif anchor and dest.suffix == ".md" and anchor not in anchors(dest, cache):
-                problems.append(f"{where}: no heading with anchor #{anchor} in {dest.relative_to(ROOT)}")
+                problems.append(f"{where}: no heading with anchor #{anchor} in {shown(dest)}")
     return problems
 
 
