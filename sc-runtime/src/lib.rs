@@ -1,10 +1,14 @@
 //! Skeleton Climbing isosurface extraction.
 //!
-//! The core (the layer sweep) is `no_std` and allocation-free: it walks a grid layer by layer with
-//! O(nx·ny) caller-provided scratch and hands vertices and triangles to a [`Sink`]. With the
-//! `alloc` feature, [`extract`] builds an indexed [`Mesh`] and [`SliceStreamer`] meshes a volume
-//! fed one z-slice at a time; with `std` (default), [`extract_par`] splits the z range over threads
-//! and produces a byte-identical mesh for any thread count.
+//! The crate has two layers, one folder each:
+//! - the **kernel** (`kernel/`): `no_std` and allocation-free, it sweeps a grid layer by layer
+//!   with O(nx·ny) caller-provided [`Scratch`] and hands vertices and triangles to a [`Sink`];
+//! - the **drivers** (`drivers/`): they run a sweep over a volume in memory ([`extract_into`],
+//!   [`extract`], [`Extractor`]), on threads ([`extract_par`], a mesh byte-identical to one
+//!   thread's for any thread count), block by block ([`extract_block`], [`BlockMesh`]) or slice by
+//!   slice ([`SliceStreamer`]).
+//!
+//! [`extract`] and [`Extractor`] need the `alloc` feature, [`extract_par`] `std` (the default).
 #![no_std]
 #![warn(missing_docs)]
 
@@ -15,55 +19,30 @@ extern crate std;
 
 extern crate self as sc_runtime;
 
-mod error;
-pub mod geometry;
-mod params;
-mod scalar;
-pub mod tables;
+mod drivers;
+mod kernel;
 
-pub use error::Error;
-pub use params::{Axes, ErrorBound, Mode, Params, Volume};
-pub use scalar::Scalar;
-mod stats;
-pub use stats::Stats;
+pub use kernel::error::Error;
+pub use kernel::params::{Axes, ErrorBound, Mode, Params, Volume};
+pub use kernel::scalar::Scalar;
+pub use kernel::scratch::{Scratch, ScratchLen};
+pub use kernel::sink::Sink;
+pub use kernel::stats::Stats;
+pub use kernel::{geometry, tables};
+
+pub use drivers::borrowed::extract_into;
+pub use drivers::stream::SliceStreamer;
 
 #[cfg(feature = "alloc")]
 mod mesh;
 #[cfg(feature = "alloc")]
+pub use drivers::blocks::{BlockMesh, block_samples, edge_key, extract_block};
+#[cfg(feature = "alloc")]
+pub use drivers::reuse::{Extractor, extract};
+#[cfg(feature = "alloc")]
 pub use mesh::Mesh;
-#[cfg(feature = "alloc")]
-mod extractor;
-#[cfg(feature = "alloc")]
-pub use extractor::{Extractor, extract};
-#[cfg(feature = "alloc")]
-mod block;
-#[cfg(feature = "alloc")]
-mod survey;
-#[cfg(feature = "alloc")]
-pub use block::{BlockMesh, block_samples, edge_key, extract_block};
-
-mod extract;
-mod prefetch;
-mod stream;
-pub use extract::extract_into;
-pub use stream::SliceStreamer;
 
 #[cfg(feature = "std")]
 pub mod demo;
 #[cfg(feature = "std")]
-mod parallel;
-#[cfg(feature = "std")]
-pub use parallel::extract_par;
-#[cfg(feature = "std")]
-mod claims;
-#[cfg(feature = "std")]
-mod region;
-#[cfg(feature = "std")]
-mod spare;
-
-mod scratch;
-mod sink;
-mod sweep;
-mod vertex;
-pub use scratch::{Scratch, ScratchLen};
-pub use sink::Sink;
+pub use drivers::threads::extract_par;

@@ -1,7 +1,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::sink::Unsettled;
+use crate::kernel::sink::Unsettled;
 use crate::{Error, Params, Scratch, Sink, Stats};
 
 /// An indexed triangle mesh: one vertex per surviving occupied grid edge, none unreferenced.
@@ -299,9 +299,10 @@ pub(crate) fn release_spare<T>(_: &mut Vec<T>, _: usize) {}
 
 #[cfg(test)]
 mod tests {
-    use crate::extract::InMemory;
-    use crate::survey::Survey;
-    use crate::{Params, Scalar, Volume, extract};
+    use crate::drivers::InMemory;
+    use crate::drivers::survey::Survey;
+    use crate::kernel::Binary;
+    use crate::{Params, Volume, extract};
     use alloc::vec::Vec;
 
     /// A ball in the first quarter of the layers: after its first layers the sweep's hints
@@ -322,7 +323,8 @@ mod tests {
             data: &data,
             nxy: 32 * 32,
         };
-        let estimate = Survey::new(&src, dims, f32::threshold(0.0)).between(0, dims[2]);
+        let estimate =
+            Survey::new(&src, dims, &Binary::<f32>::new(&Params::new(0.0))).between(0, dims[2]);
         let reserved = estimate + estimate / 2;
         let mesh = extract(&Volume::new(&data, dims).unwrap(), &Params::new(0.0)).unwrap();
         assert!(

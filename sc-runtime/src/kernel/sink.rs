@@ -1,6 +1,6 @@
-use crate::vertex::unit;
+use crate::kernel::vertex::unit;
 #[cfg(feature = "alloc")]
-use crate::vertex::units;
+use crate::kernel::vertex::units;
 
 /// Receives the mesh as it is built: vertex `i` is the `i`-th vertex sent ([`Sink::vertex`],
 /// [`Sink::edge_vertex`] or [`Sink::edge_vertex_toward`], by the sweep that produced it), and
@@ -145,7 +145,7 @@ impl Unsettled {
 #[cfg(test)]
 mod tests {
     use super::{NormalColumn, Unsettled};
-    use crate::vertex::unit;
+    use crate::kernel::vertex::unit;
     use alloc::vec::Vec;
 
     /// Normals in two slices split at `at` (or at the end, if shorter), as a stretch holds its

@@ -1,3 +1,8 @@
+//! The threads driver: z chunks of one volume swept on threads, into one output.
+
+mod claims;
+mod region;
+
 use std::sync::Mutex;
 use std::time::Instant;
 use std::vec;
@@ -5,14 +10,16 @@ use std::vec::Vec;
 
 use rayon::prelude::*;
 
-use crate::claims::{Claims, Progress};
-use crate::extract::{InMemory, has_cubes};
+use claims::{Claims, Progress};
+use region::{Filled, Stretch};
+
+use crate::drivers::reuse;
+use crate::drivers::spare::SPARES;
+use crate::drivers::survey::{self, Survey};
+use crate::drivers::{InMemory, has_cubes};
+use crate::kernel::sink::Unsettled;
+use crate::kernel::{Binary, Engine, Layers};
 use crate::mesh::{OwnedScratch, push_to_columns, release_spare};
-use crate::region::{self, Filled, Stretch};
-use crate::sink::Unsettled;
-use crate::spare::SPARES;
-use crate::survey::{self, Survey};
-use crate::sweep::Sweep;
 use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
 
 /// Layers per chunk at least: a chunk re-reads up to three slices of its neighbour, so tiny
@@ -114,13 +121,24 @@ pub fn extract_par<T: Scalar>(
     threads: usize,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Mesh, Error> {
+    sweep_par(&Binary::new(params), volume, params, threads, progress)
+}
+
+/// [`extract_par`] with any engine.
+pub(crate) fn sweep_par<T: Scalar>(
+    engine: &impl Engine<T>,
+    volume: &Volume<'_, T>,
+    params: &Params,
+    threads: usize,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Mesh, Error> {
     let dims = volume.dims();
     if !has_cubes(dims) {
         return Ok(Mesh::default());
     }
     if threads == 1 {
         // No pool, no chunks, no stitching copy.
-        let mesh = crate::extract(volume, params)?;
+        let mesh = reuse::sweep(engine, volume, params)?;
         progress(dims[2] - 1);
         return Ok(mesh);
     }
@@ -141,11 +159,7 @@ pub fn extract_par<T: Scalar>(
         .as_ref()
         .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     let chunks = chunk_count(layers, workers);
-    let src = InMemory {
-        data: volume.data(),
-        nxy: dims[0] * dims[1],
-    };
-    let threshold = T::threshold(params.iso);
+    let src = InMemory::new(volume);
     let step = survey::slice_step(dims[2], chunks);
     let survey = Survey::from_sampled(
         step,
@@ -154,7 +168,7 @@ pub fn extract_par<T: Scalar>(
             .collect::<Vec<_>>()
             .par_iter()
             .map_init(Vec::new, |signs, &z| {
-                survey::sampled_slice(&src, dims, threshold, z, signs)
+                survey::sampled_slice(&src, dims, engine, z, signs)
             })
             .collect(),
     );
@@ -216,7 +230,7 @@ pub fn extract_par<T: Scalar>(
                     let own = &claims[c];
                     sweep_part(
                         &mut scratch,
-                        (&src, dims, params),
+                        (engine, &src, dims, params),
                         z0,
                         region,
                         progress,
@@ -235,7 +249,7 @@ pub fn extract_par<T: Scalar>(
                         break;
                     };
                     let mut layers = at..end;
-                    let src = (&src, dims, params);
+                    let src = (engine, &src, dims, params);
                     parts.push(sweep_part(&mut scratch, src, at, room, progress, |_| {
                         layers.next()
                     })?);
@@ -256,15 +270,15 @@ pub fn extract_par<T: Scalar>(
 }
 
 /// Sweeps the layers `next` hands out, from `z0` on, into `region`.
-fn sweep_part<'r, T: Scalar>(
+fn sweep_part<'r, T: Scalar, E: Engine<T>>(
     scratch: &mut OwnedScratch,
-    (src, dims, params): (&InMemory<'_, T>, [usize; 3], &Params),
+    (engine, src, dims, params): (&E, &InMemory<'_, T>, [usize; 3], &Params),
     z0: usize,
     mut region: Region<'r>,
     progress: &(dyn Fn(usize) + Sync),
     mut next: impl FnMut(&mut Region<'r>) -> Option<usize>,
 ) -> Result<Part, Error> {
-    let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
+    let mut sweep = engine.sweep(dims, params, scratch.lend());
     sweep.start(z0, src, &mut region, z0 == 0)?;
     let first_plane = if z0 == 0 { 0 } else { sweep.ids_used() };
     while let Some(k) = next(&mut region) {
@@ -447,11 +461,12 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
 
 #[cfg(test)]
 mod tests {
+    use super::claims::Progress;
     use super::{MIN_CHUNK_LAYERS, MIN_TAIL, balanced_bounds, chunk_count, cut};
-    use crate::claims::Progress;
-    use crate::extract::InMemory;
-    use crate::survey::Survey;
-    use crate::{Mode, Params, Scalar, Volume, demo, extract, extract_par};
+    use crate::drivers::InMemory;
+    use crate::drivers::survey::Survey;
+    use crate::kernel::Binary;
+    use crate::{Mode, Params, Volume, demo, extract, extract_par};
     use std::format;
     use std::sync::OnceLock;
     use std::sync::atomic::{AtomicUsize, Ordering};
@@ -545,7 +560,7 @@ mod tests {
             data: &data,
             nxy: 32 * 32,
         };
-        let survey = Survey::new(&src, dims, u8::threshold(0.5));
+        let survey = Survey::new(&src, dims, &Binary::<u8>::new(&Params::new(0.5)));
         let bounds = balanced_bounds(&super::layer_work(&survey, dims), 4);
         assert_eq!(bounds.len(), 4);
         assert_eq!(bounds.first().map(|b| b.0), Some(0));

@@ -14,10 +14,10 @@ use alloc::vec::Vec;
 use core::cmp::Reverse;
 use core::ops::Range;
 
-use crate::extract::InMemory;
+use crate::drivers::InMemory;
+use crate::kernel::sink::Unsettled;
+use crate::kernel::{Binary, Engine, Layers};
 use crate::mesh::OwnedScratch;
-use crate::sink::Unsettled;
-use crate::sweep::Sweep;
 use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
 
 /// The samples meshing the cubes `cubes` (lower corners, per axis) of a grid of `grid` samples
@@ -198,6 +198,18 @@ pub fn extract_block<T: Scalar>(
     cubes: [Range<usize>; 3],
     params: &Params,
 ) -> Result<BlockMesh, Error> {
+    sweep_block(&Binary::new(params), samples, at, grid, cubes, params)
+}
+
+/// [`extract_block`] with any engine.
+pub(crate) fn sweep_block<T: Scalar>(
+    engine: &impl Engine<T>,
+    samples: &Volume<'_, T>,
+    at: [usize; 3],
+    grid: [usize; 3],
+    cubes: [Range<usize>; 3],
+    params: &Params,
+) -> Result<BlockMesh, Error> {
     let need = block_samples(grid, cubes.clone())?;
     let dims = samples.dims();
     for d in 0..3 {
@@ -228,15 +240,12 @@ pub fn extract_block<T: Scalar>(
         unsettled: Unsettled::default(),
     };
     let mut scratch = OwnedScratch::new(dims)?;
-    let mut sweep = Sweep::<T>::new(dims, params, scratch.lend());
+    let mut sweep = engine.sweep(dims, params, scratch.lend());
     sweep.restrict(
         at,
         core::array::from_fn(|d| (cubes[d].start - at[d], cubes[d].end - at[d])),
     );
-    let src = InMemory {
-        data: samples.data(),
-        nxy: dims[0] * dims[1],
-    };
+    let src = InMemory::new(samples);
     sweep.start(0, &src, &mut collect, true)?;
     for k in 0..dims[2] - 1 {
         sweep.layer(k, &src, &mut collect)?;

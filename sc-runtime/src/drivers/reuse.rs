@@ -1,11 +1,13 @@
 //! Repeated extractions into the same buffers.
 
-use crate::extract::{InMemory, has_cubes};
-use crate::mesh::{OwnedScratch, Presized};
+use crate::drivers::borrowed::sweep_into;
 #[cfg(feature = "std")]
-use crate::spare::SPARES;
-use crate::survey::Survey;
-use crate::{Error, Mesh, Params, Scalar, Stats, Volume, extract_into};
+use crate::drivers::spare::SPARES;
+use crate::drivers::survey::Survey;
+use crate::drivers::{InMemory, has_cubes};
+use crate::kernel::{Binary, Engine};
+use crate::mesh::{OwnedScratch, Presized};
+use crate::{Error, Mesh, Params, Scalar, Stats, Volume};
 
 /// Extracts on one thread into buffers it keeps from one call to the next: for an iso slider, a
 /// time series, or any loop that meshes volumes of one size again and again.
@@ -44,6 +46,16 @@ impl Extractor {
         volume: &Volume<'_, T>,
         params: &Params,
     ) -> Result<&Mesh, Error> {
+        self.sweep(&Binary::new(params), volume, params)
+    }
+
+    /// [`Extractor::extract`] with any engine.
+    pub(crate) fn sweep<T: Scalar>(
+        &mut self,
+        engine: &impl Engine<T>,
+        volume: &Volume<'_, T>,
+        params: &Params,
+    ) -> Result<&Mesh, Error> {
         let dims = volume.dims();
         self.scratch.fit(dims)?;
         let mesh = &mut self.mesh;
@@ -53,14 +65,11 @@ impl Extractor {
         mesh.triangles.clear();
         mesh.stats = Stats::default();
         if has_cubes(dims) {
-            let src = InMemory {
-                data: volume.data(),
-                nxy: dims[0] * dims[1],
-            };
-            let survey = Survey::new(&src, dims, T::threshold(params.iso));
+            let survey = Survey::new(&InMemory::new(volume), dims, engine);
             mesh.reserve_for(survey.between(0, dims[2]), params);
         }
-        mesh.stats = extract_into(
+        mesh.stats = sweep_into(
+            engine,
             volume,
             params,
             self.scratch.lend(),
@@ -88,12 +97,21 @@ impl Extractor {
 /// assert_eq!(mesh.stats.t13, 13_968); // the paper's Table 1, Steps 1–3
 /// ```
 pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
+    sweep(&Binary::new(params), volume, params)
+}
+
+/// [`extract`] with any engine.
+pub(crate) fn sweep<T: Scalar>(
+    engine: &impl Engine<T>,
+    volume: &Volume<'_, T>,
+    params: &Params,
+) -> Result<Mesh, Error> {
     let mut extractor = Extractor::new();
     #[cfg(feature = "std")]
     {
         extractor.scratch = SPARES.take(volume.dims())?;
     }
-    let done = extractor.extract(volume, params).map(drop);
+    let done = extractor.sweep(engine, volume, params).map(drop);
     #[cfg(feature = "std")]
     SPARES.give(core::mem::take(&mut extractor.scratch));
     done.map(|()| extractor.into_mesh())

@@ -10,7 +10,7 @@
 
 use core::ops::Range;
 
-use crate::prefetch::{self, LINE};
+use crate::kernel::prefetch::{self, LINE};
 
 /// The bytes of a slice ahead, cut into one share per cube row of a triangle pass.
 pub(super) struct Ahead {

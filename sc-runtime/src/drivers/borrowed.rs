@@ -1,30 +1,6 @@
-use crate::sweep::{Slices, Sweep};
+use super::{InMemory, has_cubes};
+use crate::kernel::{Binary, Engine, Layers};
 use crate::{Error, Params, Scalar, Scratch, Sink, Stats, Volume};
-
-/// An in-memory volume seen slice by slice.
-pub(crate) struct InMemory<'a, T> {
-    pub data: &'a [T],
-    pub nxy: usize,
-}
-
-impl<T> Slices<T> for InMemory<'_, T> {
-    #[inline]
-    fn slice(&self, z: usize) -> &[T] {
-        &self.data[z * self.nxy..(z + 1) * self.nxy]
-    }
-
-    #[inline]
-    fn ahead(&self, z: usize) -> &[T] {
-        self.data
-            .get(z * self.nxy..(z + 1) * self.nxy)
-            .unwrap_or(&[])
-    }
-}
-
-/// Whether the grid has any cube: dims below 2 on an axis give an empty mesh.
-pub(crate) fn has_cubes(dims: [usize; 3]) -> bool {
-    dims.iter().all(|&d| d >= 2)
-}
 
 /// Extracts the surface without allocating: the caller lends [`Scratch`] and receives the mesh
 /// through `sink`. This is the whole algorithm; the other entry points wrap it.
@@ -54,15 +30,23 @@ pub fn extract_into<T: Scalar>(
     scratch: Scratch<'_>,
     sink: &mut impl Sink,
 ) -> Result<Stats, Error> {
+    sweep_into(&Binary::new(params), volume, params, scratch, sink)
+}
+
+/// [`extract_into`] with any engine.
+pub(crate) fn sweep_into<T: Scalar>(
+    engine: &impl Engine<T>,
+    volume: &Volume<'_, T>,
+    params: &Params,
+    scratch: Scratch<'_>,
+    sink: &mut impl Sink,
+) -> Result<Stats, Error> {
     let dims = volume.dims();
     if !has_cubes(dims) {
         return Ok(Stats::default());
     }
-    let src = InMemory {
-        data: volume.data(),
-        nxy: dims[0] * dims[1],
-    };
-    let mut sweep = Sweep::<T>::new(dims, params, scratch);
+    let src = InMemory::new(volume);
+    let mut sweep = engine.sweep(dims, params, scratch);
     sweep.start(0, &src, sink, true)?;
     for k in 0..dims[2] - 1 {
         sweep.layer(k, &src, sink)?;

@@ -15,15 +15,16 @@ use core::num::NonZeroU8;
 
 use wide::u8x16;
 
-use crate::scratch::{PAD, Scratch, WORD_PLANES};
+use crate::kernel::scratch::{PAD, Scratch, WORD_PLANES};
+use crate::kernel::vertex::{Field, InteriorPlane, InteriorRow, Normal, Steps, wide_crossing};
 use crate::tables::{BACK_SHARED, Entry};
-use crate::vertex::{Field, InteriorPlane, InteriorRow, Normal, Steps, wide_crossing};
 
 mod ahead;
 mod bound;
 mod cube_ids;
 mod edge_row;
 mod greys;
+use crate::kernel::engine::{Binary, Engine, Layers, Slices};
 use crate::{Axes, Error, Mode, Params, Scalar, Sink, Stats};
 use ahead::Ahead;
 use cube_ids::{Cube, CubeIds};
@@ -50,17 +51,6 @@ const END_BIT: u32 = 1 << 31;
 
 /// Vertex id of a grey edge merged away by Step 4.
 const MERGED: u32 = u32::MAX;
-
-/// Gives the sweep the slices it asks for; `z` is always within what the step needs.
-pub(crate) trait Slices<T> {
-    fn slice(&self, z: usize) -> &[T];
-    /// Slice `z` if it is in memory already, so that it can be fetched into the cache before it
-    /// is needed ([`Ahead`]); empty past the grid and for a source that reads slices as the
-    /// sweep goes.
-    fn ahead(&self, _z: usize) -> &[T] {
-        &[]
-    }
-}
 
 /// What Step 4 does with an occupied grey edge.
 #[derive(Clone, Copy)]
@@ -129,8 +119,26 @@ pub(crate) struct Sweep<'s, T: Scalar> {
     steps: Steps,
 }
 
+impl<T: Scalar> Engine<T> for Binary<T> {
+    type Sweep<'s> = Sweep<'s, T>;
+
+    fn sweep<'s>(&self, dims: [usize; 3], params: &Params, scratch: Scratch<'s>) -> Sweep<'s, T> {
+        Sweep::new(dims, params, self.threshold, scratch)
+    }
+
+    #[cfg(feature = "alloc")]
+    fn classify_row(&self, row: &[T], out: &mut [u8]) {
+        T::classify_row(row, self.threshold, out);
+    }
+}
+
 impl<'s, T: Scalar> Sweep<'s, T> {
-    pub fn new(dims: [usize; 3], params: &Params, scratch: Scratch<'s>) -> Self {
+    fn new(
+        dims: [usize; 3],
+        params: &Params,
+        threshold: T::Threshold,
+        scratch: Scratch<'s>,
+    ) -> Self {
         let nxy = dims[0] * dims[1];
         let (filled, rest) = scratch.bytes.split_at_mut(4 * nxy + PAD);
         let (cases, merged) = rest.split_at_mut(3 * nxy + PAD);
@@ -159,17 +167,19 @@ impl<'s, T: Scalar> Sweep<'s, T> {
             },
             ids,
             params: *params,
-            threshold: T::threshold(params.iso),
+            threshold,
             first_layer: 0,
             steps: Steps::new(params.spacing),
         }
     }
+}
 
+impl<T: Scalar> Layers<T> for Sweep<'_, T> {
     /// Makes this a block's sweep: its samples start at `offset` in the whole grid, and it emits
     /// the triangles of the local cubes `own` only, counting the edges whose lower ends those
     /// cubes hold (and, on the grid's far side, the last sample's edges too).
     #[cfg(feature = "alloc")]
-    pub fn restrict(&mut self, offset: [usize; 3], own: [(usize, usize); 3]) {
+    fn restrict(&mut self, offset: [usize; 3], own: [(usize, usize); 3]) {
         let dims = self.grid.dims;
         self.grid.offset = offset;
         self.grid.own_cubes = own;
@@ -186,20 +196,20 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         });
     }
 
-    pub fn stats(&self) -> Stats {
+    fn stats(&self) -> Stats {
         self.out.stats
     }
 
     /// Number of vertex ids handed out, including those of a first plane not emitted.
     #[cfg(feature = "std")]
-    pub fn ids_used(&self) -> u32 {
+    fn ids_used(&self) -> u32 {
         self.out.next_id
     }
 
     /// Prepares layer `z0`: classifies slices `z0 − 1 ..= z0 + 1`, computes cases of layers
     /// `z0 − 1` and `z0`, and numbers plane `z0`'s vertices. With `emit_plane` false (a parallel
     /// chunk after the first), those vertices are numbered but belong to the previous chunk.
-    pub fn start(
+    fn start(
         &mut self,
         z0: usize,
         src: &impl Slices<T>,
@@ -224,12 +234,7 @@ impl<'s, T: Scalar> Sweep<'s, T> {
     }
 
     /// Runs layer `k`; slices `k − 1 ..= k + 2` (those that exist) must be readable.
-    pub fn layer(
-        &mut self,
-        k: usize,
-        src: &impl Slices<T>,
-        sink: &mut impl Sink,
-    ) -> Result<(), Error> {
+    fn layer(&mut self, k: usize, src: &impl Slices<T>, sink: &mut impl Sink) -> Result<(), Error> {
         if k + 2 < self.grid.dims[2] {
             self.grid
                 .classify::<T>(k + 2, src.slice(k + 2), self.threshold);
@@ -273,7 +278,9 @@ impl<'s, T: Scalar> Sweep<'s, T> {
         }
         Ok(())
     }
+}
 
+impl<T: Scalar> Sweep<'_, T> {
     fn field<'v>(&self, src: &'v impl Slices<T>, z_lo: usize, z_hi: usize) -> Field<'v, T> {
         let nz = self.grid.dims[2];
         let first = z_lo.saturating_sub(1);

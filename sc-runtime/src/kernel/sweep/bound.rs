@@ -10,8 +10,8 @@
 
 use super::Grid;
 use crate::geometry::point_triangle_distance_squared as distance_squared;
+use crate::kernel::vertex::{Field, edge_crossing};
 use crate::tables::Entry;
-use crate::vertex::{Field, edge_crossing};
 use crate::{ErrorBound, Params, Scalar};
 
 impl Grid<'_> {

@@ -1,4 +1,5 @@
-use crate::sweep::{Slices, Sweep};
+use crate::kernel::sweep::Sweep;
+use crate::kernel::{Binary, Engine, Layers, Slices};
 use crate::{Error, Params, Scalar, Scratch, Sink, Stats};
 
 /// Meshes a volume fed one z-slice at a time, holding only four slices: a volume larger than
@@ -60,7 +61,7 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
         let nxy = dims[0] * dims[1];
         Ok(SliceStreamer {
             dims,
-            sweep: Sweep::new(dims, params, scratch),
+            sweep: Binary::new(params).sweep(dims, params, scratch),
             ring: Ring { buf: ring, nxy },
             received: 0,
             sink,
@@ -82,7 +83,7 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
         let z = self.received;
         self.ring.buf[(z % 4) * nxy..][..nxy].copy_from_slice(slice);
         self.received += 1;
-        if !crate::extract::has_cubes(self.dims) {
+        if !crate::drivers::has_cubes(self.dims) {
             return Ok(());
         }
         match z {
@@ -101,7 +102,7 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
                 actual: self.received * self.ring.nxy,
             });
         }
-        if crate::extract::has_cubes(self.dims) {
+        if crate::drivers::has_cubes(self.dims) {
             self.sweep
                 .layer(self.dims[2] - 2, &self.ring, &mut self.sink)?;
         }

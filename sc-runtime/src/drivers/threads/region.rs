@@ -16,8 +16,8 @@ use rayon::prelude::*;
 
 #[cfg(doc)]
 use crate::Mesh;
+use crate::kernel::sink::NormalColumn;
 use crate::mesh::{PushIf, huge_pages};
-use crate::sink::NormalColumn;
 
 /// A chunk's stretch of a shared vector: pushes go to the stretch until it is full, then to a
 /// vector of the chunk's own (the survey fell short, which the join handles by copying).

@@ -1,5 +1,5 @@
 //! Asking for memory before a pass reads it, for the passes that would otherwise wait on it: the
-//! classification of each slice ([`crate::sweep`]'s slice ahead) and the survey's scattered rows.
+//! classification of each slice (the sweep's slice ahead) and the survey's scattered rows.
 //! A prefetch is only a hint: it reads nothing the program sees and changes no result.
 
 use core::ops::Range;

@@ -14,8 +14,9 @@
 
 use alloc::vec::Vec;
 
-use crate::sweep::Slices;
-use crate::{Scalar, prefetch};
+use crate::Scalar;
+use crate::kernel::prefetch;
+use crate::kernel::{Engine, Slices};
 
 /// Slices between the sampled ones, at most.
 const SLICE_STEP: usize = 8;
@@ -42,14 +43,14 @@ pub(crate) struct Survey {
 
 impl Survey {
     /// Surveys every sampled slice on this thread.
-    pub fn new<T: Scalar>(src: &impl Slices<T>, dims: [usize; 3], threshold: T::Threshold) -> Self {
+    pub fn new<T: Scalar>(src: &impl Slices<T>, dims: [usize; 3], engine: &impl Engine<T>) -> Self {
         let mut signs = Vec::new();
         let step = slice_step(dims[2], 1);
         Survey {
             step,
             sampled: (0..dims[2])
                 .step_by(step)
-                .map(|z| sampled_slice(src, dims, threshold, z, &mut signs))
+                .map(|z| sampled_slice(src, dims, engine, z, &mut signs))
                 .collect(),
         }
     }
@@ -82,7 +83,7 @@ impl Survey {
 pub(crate) fn sampled_slice<T: Scalar>(
     src: &impl Slices<T>,
     [nx, ny, nz]: [usize; 3],
-    threshold: T::Threshold,
+    engine: &impl Engine<T>,
     z: usize,
     signs: &mut Vec<u8>,
 ) -> usize {
@@ -108,14 +109,14 @@ pub(crate) fn sampled_slice<T: Scalar>(
         if let Some(rows) = above.and_then(|above| above.get(ahead * nx..)) {
             prefetch::all(&rows[..rows.len().min(nx)]);
         }
-        T::classify_row(&here[y * nx..][..nx], threshold, row);
+        engine.classify_row(&here[y * nx..][..nx], row);
         n += differ(&row[1..], &row[..nx - 1]);
         if y + 1 < ny {
-            T::classify_row(&here[(y + 1) * nx..][..nx], threshold, next);
+            engine.classify_row(&here[(y + 1) * nx..][..nx], next);
             n += differ(row, next);
         }
         if let Some(above) = above {
-            T::classify_row(&above[y * nx..][..nx], threshold, up);
+            engine.classify_row(&above[y * nx..][..nx], up);
             n += differ(row, up);
         }
     }
@@ -125,8 +126,9 @@ pub(crate) fn sampled_slice<T: Scalar>(
 #[cfg(all(test, feature = "std"))]
 mod tests {
     use super::Survey;
-    use crate::extract::InMemory;
-    use crate::{Params, Scalar, Volume, demo, extract};
+    use crate::drivers::InMemory;
+    use crate::kernel::Binary;
+    use crate::{Params, Volume, demo, extract};
 
     /// The survey's estimate of Steps 1–3's vertices, against their count, on the built-in
     /// volumes: within what the mesh's reserve (half as much again) covers with room to spare.
@@ -142,7 +144,7 @@ mod tests {
                 data: &v.data,
                 nxy: v.dims[0] * v.dims[1],
             };
-            let survey = Survey::new(&src, v.dims, f64::threshold(v.iso));
+            let survey = Survey::new(&src, v.dims, &Binary::<f64>::new(&Params::new(v.iso)));
             let estimate = survey.between(0, v.dims[2]) as f64;
             let mesh =
                 extract(&Volume::new(&v.data, v.dims).unwrap(), &Params::new(v.iso)).unwrap();

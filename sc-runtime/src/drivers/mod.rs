@@ -1,0 +1,63 @@
+//! The drivers: how a sweep is run over a volume, and where its output goes.
+//!
+//! Each driver is written against the kernel's [`Engine`](crate::kernel::Engine) seam, not
+//! against one sweep, and the public entry points pick Skeleton Climbing's binary engine:
+//! - [`borrowed`]: one sweep into a caller's sink and scratch, no allocation (`extract_into`);
+//! - [`reuse`]: one thread into an owned mesh, buffers kept between calls (`Extractor`, `extract`);
+//! - [`threads`]: z chunks on threads, stitched into the one-thread mesh (`extract_par`);
+//! - [`blocks`]: a block of the grid with its halo, merged exactly with the others
+//!   (`extract_block`, `BlockMesh`);
+//! - [`stream`]: slices pushed one at a time through a ring of four (`SliceStreamer`).
+
+use crate::kernel::Slices;
+use crate::{Scalar, Volume};
+
+pub(crate) mod borrowed;
+pub(crate) mod stream;
+
+#[cfg(feature = "alloc")]
+pub(crate) mod blocks;
+#[cfg(feature = "alloc")]
+pub(crate) mod reuse;
+#[cfg(feature = "alloc")]
+pub(crate) mod survey;
+
+#[cfg(feature = "std")]
+pub(crate) mod spare;
+#[cfg(feature = "std")]
+pub(crate) mod threads;
+
+/// An in-memory volume seen slice by slice.
+pub(crate) struct InMemory<'a, T> {
+    pub data: &'a [T],
+    pub nxy: usize,
+}
+
+impl<'a, T: Scalar> InMemory<'a, T> {
+    pub fn new(volume: &Volume<'a, T>) -> Self {
+        let [nx, ny, _] = volume.dims();
+        InMemory {
+            data: volume.data(),
+            nxy: nx * ny,
+        }
+    }
+}
+
+impl<T> Slices<T> for InMemory<'_, T> {
+    #[inline]
+    fn slice(&self, z: usize) -> &[T] {
+        &self.data[z * self.nxy..(z + 1) * self.nxy]
+    }
+
+    #[inline]
+    fn ahead(&self, z: usize) -> &[T] {
+        self.data
+            .get(z * self.nxy..(z + 1) * self.nxy)
+            .unwrap_or(&[])
+    }
+}
+
+/// Whether the grid has any cube: dims below 2 on an axis give an empty mesh.
+pub(crate) fn has_cubes(dims: [usize; 3]) -> bool {
+    dims.iter().all(|&d| d >= 2)
+}
