@@ -88,7 +88,7 @@ impl CaseTables {
 }
 
 /// The committed tables.
-pub static DEFAULT: CaseTables = sc_macros::include_tables!("../tables/skeleton-climbing.ron");
+pub static DEFAULT: CaseTables = sc_macros::include_tables!("tables/skeleton-climbing.ron");
 
 /// The grey edge of class `p` along `axis` (SPEC §2), as a cube-local edge id.
 #[inline]

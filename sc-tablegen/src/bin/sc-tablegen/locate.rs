@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 pub const RELATIVE: &str = "tables/skeleton-climbing.ron";
 
 /// The tables this binary was built with, for `dump` outside a checkout.
-pub const EMBEDDED: &str = include_str!("../../../../tables/skeleton-climbing.ron");
+pub const EMBEDDED: &str = include_str!("../../../tables/skeleton-climbing.ron");
 
 /// Where tables come from.
 pub enum Source {
