@@ -2,13 +2,11 @@
 
 use std::io::{self, Write};
 
-use sc_runtime::Mesh;
-
-use super::WriteOptions;
 use super::text::Lines;
+use super::{MeshSlices, WriteOptions};
 
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.
-pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write(mesh: MeshSlices<'_>, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
     writeln!(
         out,
         "# skelclimb (Skeleton Climbing): {} vertices, {} triangles\n# coordinates: {}",
@@ -17,7 +15,7 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
         options.coordinates()
     )?;
     let mut lines = Lines::new(out);
-    for (tag, vectors) in [("v ", &mesh.positions), ("vn ", &mesh.normals)] {
+    for (tag, vectors) in [("v ", mesh.positions), ("vn ", mesh.normals)] {
         for &[x, y, z] in vectors {
             lines
                 .text(tag)
@@ -30,7 +28,7 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
         }
     }
     let with_normals = !mesh.normals.is_empty();
-    for t in &mesh.triangles {
+    for t in mesh.triangles {
         lines.text("f");
         for i in t.map(|i| u64::from(i) + 1) {
             lines.text(" ").int(i);
@@ -65,7 +63,7 @@ mod tests {
     fn round_trips_through_tobj() {
         let mesh = tetrahedron();
         let mut bytes = Vec::new();
-        write(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
+        write((&mesh).into(), &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         // tobj renumbers vertices in order of first use: compare what each corner points at.
         assert_eq!(back.positions.len(), 3 * mesh.positions.len());
@@ -82,7 +80,7 @@ mod tests {
         let mut mesh = tetrahedron();
         mesh.normals.clear();
         let mut bytes = Vec::new();
-        write(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
+        write((&mesh).into(), &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.normals.is_empty());
         assert_eq!(back.indices.len(), 12);
