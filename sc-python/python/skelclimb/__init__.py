@@ -254,11 +254,11 @@ def extract(
         The iso value. Integer volumes are compared exactly in their own type.
     affine : (4, 4) array, optional
         The map from sample index ``(x, y, z, 1)`` to the scanner's world, as :func:`load`
-        returns it: ``x`` is the last axis of a C-ordered array (the first of a Fortran-ordered
-        one, so nibabel's ``img.affine`` fits ``img.get_fdata()`` as it is). Vertices and normals
-        are mapped into that world exactly as the ``skelclimb`` command maps them (a mirroring
-        affine reverses the winding, so that faces still point out). It must be finite and
-        invertible with ``(0, 0, 0, 1)`` as its last row.
+        returns it: ``x`` is the last axis of a C-ordered array, the first of a Fortran-ordered
+        one (so nibabel's ``img.affine`` fits ``np.asfortranarray(img.get_fdata())``). Vertices
+        and normals are mapped into that world exactly as the ``skelclimb`` command maps them (a
+        mirroring affine reverses the winding, so that faces still point out). It must be finite
+        and invertible with ``(0, 0, 0, 1)`` as its last row.
     space : ``"RAS"``, ``"LPS"`` or None
         The world's convention, recorded in ``stats["space"]`` and in saved files; :func:`load`
         returns it beside the affine.
