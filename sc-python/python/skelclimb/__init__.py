@@ -189,13 +189,11 @@ def _pad(volume, level):
     return np.pad(volume, 1, constant_values=fill), order
 
 
-def _placement(affine, space, spacing, origin):
-    """The top three rows of ``affine`` (checked against any ``spacing`` and ``origin`` given),
-    or None, and the checked ``space``."""
-    if space not in (None, "RAS", "LPS"):
-        raise ValueError(f"space: expected 'RAS', 'LPS' or None, got {space!r}")
+def _affine(affine, spacing, origin):
+    """``affine`` as a checked 4×4 float64 copy, or None; any ``spacing`` and ``origin`` given
+    beside it must agree with it."""
     if affine is None:
-        return None, space
+        return None
     try:
         affine = np.array(affine, dtype=np.float64)
     except (TypeError, ValueError):
@@ -222,7 +220,7 @@ def _placement(affine, space, spacing, origin):
             f"origin: {tuple(origin)} contradicts the affine's translation "
             f"{tuple(affine[:3, 3])}; give the affine alone"
         )
-    return affine, space
+    return affine
 
 
 def extract(
@@ -308,7 +306,7 @@ def extract(
     """
     volume = _volume(volume)
     level = _level(level)
-    affine, space = _placement(affine, space, spacing, origin)
+    affine = _affine(affine, spacing, origin)
     spacing = _triple((1, 1, 1) if spacing is None else spacing, "spacing")
     origin = _triple((0, 0, 0) if origin is None else origin, "origin")
     if mode not in _MODES:
