@@ -370,8 +370,8 @@ def load(path, **options):
     * ``affine``: the 4×4 map from sample index ``(x, y, z, 1)`` to world coordinates, as the
       file states it (NIfTI sform or qform, NRRD space directions, MetaImage TransformMatrix,
       DICOM orientation and position; index × spacing + origin for raw and NumPy files);
-    * ``space``: the convention of that world, ``"RAS"`` (NIfTI) or ``"LPS"`` (DICOM,
-      MetaImage, NRRD in LPS space), or None for a file without one.
+    * ``space``: the convention of that world as the file states it, ``"RAS"`` (NIfTI, NRRD in
+      RAS space) or ``"LPS"`` (DICOM, MetaImage, most NRRD), or None for a file without one.
 
     Given to :func:`extract`, the affine and space put the mesh where the ``skelclimb``
     command puts it. ``Scan.spacing`` and ``Scan.origin`` are the affine's column lengths and
