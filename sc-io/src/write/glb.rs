@@ -17,7 +17,12 @@ const UNSIGNED_INT: u32 = 5125;
 const TRIANGLES: u32 = 4;
 
 /// Writes the GLB header, the JSON chunk and the binary chunk.
-pub fn write(mesh: MeshSlices<'_>, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mesh = mesh.into();
     let too_big = || {
         io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -135,7 +140,7 @@ mod tests {
 
     fn glb(mesh: &Mesh) -> Vec<u8> {
         let mut bytes = Vec::new();
-        write(mesh.into(), &WriteOptions::default(), &mut bytes).unwrap();
+        write(mesh, &WriteOptions::default(), &mut bytes).unwrap();
         assert_eq!(bytes.len() % 4, 0);
         assert_eq!(
             u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,

@@ -6,7 +6,12 @@ use super::text::Lines;
 use super::{MeshSlices, WriteOptions};
 
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.
-pub fn write(mesh: MeshSlices<'_>, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mesh = mesh.into();
     writeln!(
         out,
         "# skelclimb (Skeleton Climbing): {} vertices, {} triangles\n# coordinates: {}",
@@ -63,7 +68,7 @@ mod tests {
     fn round_trips_through_tobj() {
         let mesh = tetrahedron();
         let mut bytes = Vec::new();
-        write((&mesh).into(), &WriteOptions::default(), &mut bytes).unwrap();
+        write(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         // tobj renumbers vertices in order of first use: compare what each corner points at.
         assert_eq!(back.positions.len(), 3 * mesh.positions.len());
@@ -80,7 +85,7 @@ mod tests {
         let mut mesh = tetrahedron();
         mesh.normals.clear();
         let mut bytes = Vec::new();
-        write((&mesh).into(), &WriteOptions::default(), &mut bytes).unwrap();
+        write(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.normals.is_empty());
         assert_eq!(back.indices.len(), 12);

@@ -31,11 +31,12 @@ fn header(
 /// Binary little-endian PLY. Records are encoded into a buffer a few thousand at a time and
 /// written in one call each: writing them field by field through the `BufWriter` cost as much as
 /// a quarter of the whole extraction.
-pub fn write_binary(
-    mesh: MeshSlices<'_>,
+pub fn write_binary<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
     options: &WriteOptions,
     out: &mut impl Write,
 ) -> io::Result<()> {
+    let mesh = mesh.into();
     header(mesh, "binary_little_endian", options, out)?;
     let with_normals = !mesh.normals.is_empty();
     if !with_normals {
@@ -65,11 +66,12 @@ fn put_floats(rec: &mut [u8], values: &[f32; 3]) {
 }
 
 /// ASCII PLY; floats are printed in their shortest exact form, so nothing is lost.
-pub fn write_ascii(
-    mesh: MeshSlices<'_>,
+pub fn write_ascii<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
     options: &WriteOptions,
     out: &mut impl Write,
 ) -> io::Result<()> {
+    let mesh = mesh.into();
     header(mesh, "ascii", options, out)?;
     let mut lines = Lines::new(out);
     for (i, [x, y, z]) in mesh.positions.iter().enumerate() {
@@ -144,7 +146,7 @@ mod tests {
                 mesh.normals.clear();
             }
             let mut bytes = Vec::new();
-            write_binary((&mesh).into(), &WriteOptions::default(), &mut bytes).unwrap();
+            write_binary(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
             let back = read_back(&bytes);
             assert_eq!(
                 (back.positions, back.normals, back.triangles),
@@ -158,7 +160,7 @@ mod tests {
         let mut mesh = tetrahedron();
         mesh.normals.clear();
         let mut bytes = Vec::new();
-        write_ascii((&mesh).into(), &WriteOptions::default(), &mut bytes).unwrap();
+        write_ascii(&mesh, &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.normals.is_empty());
         assert_eq!(
@@ -170,7 +172,7 @@ mod tests {
     #[test]
     fn empty_mesh_is_a_valid_file() {
         let mut bytes = Vec::new();
-        write_binary(MeshSlices::default(), &WriteOptions::default(), &mut bytes).unwrap();
+        write_binary(&Mesh::default(), &WriteOptions::default(), &mut bytes).unwrap();
         let back = read_back(&bytes);
         assert!(back.positions.is_empty() && back.triangles.is_empty());
     }

@@ -5,7 +5,8 @@ use std::io::{self, Write};
 use super::{MeshSlices, in_chunks};
 
 /// Writes the 80-byte header, the triangle count and one 50-byte record per triangle.
-pub fn write(mesh: MeshSlices<'_>, out: &mut impl Write) -> io::Result<()> {
+pub fn write<'a>(mesh: impl Into<MeshSlices<'a>>, out: &mut impl Write) -> io::Result<()> {
+    let mesh = mesh.into();
     let mut header = [b' '; 80];
     let title = b"skelclimb (Skeleton Climbing) binary STL";
     header[..title.len()].copy_from_slice(title);
@@ -51,7 +52,7 @@ mod tests {
     fn round_trips_through_stl_io() {
         let mesh = tetrahedron();
         let mut bytes = Vec::new();
-        write((&mesh).into(), &mut bytes).unwrap();
+        write(&mesh, &mut bytes).unwrap();
         assert_eq!(bytes.len(), 84 + 50 * mesh.triangles.len());
         let back = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).unwrap();
         assert_eq!(back.faces.len(), mesh.triangles.len());
