@@ -194,6 +194,18 @@ def test_an_axis_aligned_affine_is_spacing_and_origin_to_the_bit():
     assert np.array_equal(c.vertices, a.vertices)
 
 
+def test_the_affine_maps_x_y_z_the_last_array_axis_first():
+    volume = np.zeros((6, 7, 8), np.uint8)  # (nz, ny, nx)
+    volume[2, 3, 5] = 1  # z = 2, y = 3, x = 5
+    affine = np.eye(4)
+    affine[:3, :3] = OBLIQUE * [2.0, 2.0, 3.0]
+    affine[:3, 3] = [-120.0, 40.0, 7.5]
+    m = skelclimb.extract(volume, 0.5, affine=affine, mode="steps123")
+    # The six vertices sit halfway along the sample's six edges, around it.
+    assert len(m.vertices) == 6
+    assert np.allclose(m.vertices.mean(axis=0), (affine @ [5, 3, 2, 1])[:3], rtol=0, atol=1e-4)
+
+
 def test_a_fortran_array_takes_the_affine_of_its_own_axes():
     """nibabel's arrays are (x, y, z), Fortran-ordered, with the affine of those axes."""
     volume, affine, _ = skelclimb.load(DATA / "itk-t1-mri.nii.gz")
