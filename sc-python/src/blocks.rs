@@ -94,7 +94,7 @@ pub fn finish_blocks<'py>(
     let share = from_python(&share)?;
     let grid = share.grid;
     let mesh = share.into_mesh().map_err(errors::runtime)?;
-    let stats = crate::extract::stats(py, &mesh.stats, mode, level, grid)?;
+    let stats = crate::extract::stats(py, &mesh.stats, mode, level, grid, None)?;
     (
         convert::rows(py, mesh.positions)?,
         convert::rows(py, mesh.triangles)?,

@@ -4,10 +4,12 @@ use numpy::{Element, PyUntypedArray};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use sc_io::space::{Space, World};
 use sc_runtime::{ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
 
 use crate::convert::{self, with_element};
 use crate::errors;
+use crate::world;
 
 /// Parses a mode name as the CLI spells it.
 pub fn mode(name: &str) -> PyResult<Mode> {
@@ -75,9 +77,11 @@ pub fn params(
 }
 
 /// Extracts the surface `volume = level` of a contiguous 3-D array (x fastest in memory; see
-/// `convert`). Returns `(vertices, faces, normals or None, stats)`.
+/// `convert`), at `index × spacing + origin` or, given the top three rows of an `affine`, in the
+/// world it maps to (`spacing` and `origin` are then ignored). Returns
+/// `(vertices, faces, normals or None, stats)`.
 #[pyfunction]
-#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads, max_error=None))]
+#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads, max_error=None, affine=None, space=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn extract<'py>(
     py: Python<'py>,
@@ -89,12 +93,35 @@ pub fn extract<'py>(
     normals: bool,
     threads: usize,
     max_error: Option<(f64, String)>,
+    affine: Option<[[f64; 4]; 3]>,
+    space: Option<&str>,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    let space = world::space(space)?;
+    let (spacing, world) = match affine {
+        Some(rows) => world::from_affine(rows, space)?,
+        None => (
+            spacing,
+            World {
+                space,
+                ..world::translation(origin)
+            },
+        ),
+    };
+    // As the CLI does: a translation is the extractor's origin (the same f32 arithmetic), any
+    // other map is applied to the finished mesh.
+    let origin = if world.is_translation() {
+        world.offset
+    } else {
+        [0.0; 3]
+    };
     let params = params(level, spacing, origin, mode, normals, max_error)?;
     let dims = convert::dims(volume, "volume")?;
-    let mesh =
+    let mut mesh =
         with_element!(py, volume, "volume", T => run::<T>(py, volume, dims, &params, threads))?;
-    let stats = stats(py, &mesh.stats, mode, level, dims)?;
+    if !world.is_translation() {
+        py.detach(|| world.place(&mut mesh));
+    }
+    let stats = stats(py, &mesh.stats, mode, level, dims, world.space)?;
     let Mesh {
         positions,
         normals: vertex_normals,
@@ -131,13 +158,15 @@ pub(crate) fn run<T: Scalar + Element>(
         .map_err(errors::runtime)
 }
 
-/// The figures the CLI's `--stats-json` reports, as a dict.
+/// The figures the CLI's `--stats-json` reports, as a dict, with the world convention of the
+/// vertices (`"RAS"`, `"LPS"`, or `None` for index × spacing + origin or an unstated one).
 pub fn stats<'py>(
     py: Python<'py>,
     s: &Stats,
     mode: &str,
     level: f64,
     dims: [usize; 3],
+    space: Option<Space>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let counts = |v: u64, t: u64| -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -149,6 +178,7 @@ pub fn stats<'py>(
     d.set_item("dims", dims)?;
     d.set_item("iso", level)?;
     d.set_item("mode", mode)?;
+    d.set_item("space", space.map(Space::name))?;
     d.set_item("steps123", counts(s.v13, s.t13)?)?;
     d.set_item("result", counts(s.vertices, s.triangles)?)?;
     d.set_item("merged", s.merged)?;

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -13,15 +13,17 @@ use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
 use sc_io::volume::{Dtype, Endian, Grid, Linear, Sample, Samples};
 use sc_io::with_samples;
-use sc_io::write::{MeshFormat, WriteOptions};
-use sc_runtime::Mesh;
+use sc_io::write::{MeshFormat, MeshSlices, WriteOptions};
 
 use crate::errors;
+use crate::world;
 
-/// Writes a mesh; the format follows the extension (`.ply`, `.obj`, `.stl`, `.glb`). The file
-/// appears whole or not at all.
+/// Writes a mesh straight from its NumPy arrays (C-contiguous `(n, 3)` rows, borrowed, not
+/// copied); the format follows the extension (`.ply`, `.obj`, `.stl`, `.glb`) and `space`
+/// (`"RAS"`, `"LPS"` or `None`) is recorded where the format has room. The file appears whole or
+/// not at all.
 #[pyfunction]
-#[pyo3(signature = (path, vertices, faces, normals=None, ascii=false))]
+#[pyo3(signature = (path, vertices, faces, normals=None, ascii=false, space=None))]
 pub fn save(
     py: Python<'_>,
     path: PathBuf,
@@ -29,16 +31,21 @@ pub fn save(
     faces: PyReadonlyArray2<'_, u32>,
     normals: Option<PyReadonlyArray2<'_, f32>>,
     ascii: bool,
+    space: Option<&str>,
 ) -> PyResult<()> {
     let format = MeshFormat::from_path(&path).map_err(PyValueError::new_err)?;
     if ascii && format != MeshFormat::Ply {
         return Err(PyValueError::new_err("ascii: applies to .ply files only"));
     }
-    let positions = triples(&vertices, "vertices")?;
-    let triangles = triples(&faces, "faces")?;
+    let options = WriteOptions {
+        ascii,
+        space: world::space(space)?,
+    };
+    let positions = rows(&vertices, "vertices")?;
+    let triangles = rows(&faces, "faces")?;
     let normals = match &normals {
-        Some(n) => triples(n, "normals")?,
-        None => Vec::new(),
+        Some(n) => rows(n, "normals")?,
+        None => &[],
     };
     if !normals.is_empty() && normals.len() != positions.len() {
         return Err(PyValueError::new_err(format!(
@@ -53,41 +60,38 @@ pub fn save(
             "faces: vertex index {bad} is out of range for {count} vertices"
         )));
     }
-    let mesh = Mesh {
+    let mesh = MeshSlices {
         positions,
         normals,
         triangles,
-        ..Mesh::default()
     };
-    py.detach(|| {
-        AtomicFile::create(&path)?
-            .write_with(|out| format.write(&mesh, &WriteOptions { ascii, space: None }, out))
-    })
-    .map_err(errors::io)
+    py.detach(|| AtomicFile::create(&path)?.write_with(|out| format.write(mesh, &options, out)))
+        .map_err(errors::io)
 }
 
-fn triples<T: numpy::Element + Copy>(
-    array: &PyReadonlyArray2<'_, T>,
+/// The rows of a C-contiguous `(n, 3)` array as triples, borrowed.
+fn rows<'a, T: numpy::Element>(
+    array: &'a PyReadonlyArray2<'_, T>,
     name: &str,
-) -> PyResult<Vec<[T; 3]>> {
-    let view = array.as_array();
-    if view.ncols() != 3 {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected shape (n, 3), got {:?}",
-            view.shape()
-        )));
+) -> PyResult<&'a [[T; 3]]> {
+    let shape = array.shape();
+    let flat = array
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name}: the array is not C-contiguous")))?;
+    match flat.as_chunks::<3>() {
+        (rows, []) if shape[1] == 3 => Ok(rows),
+        _ => Err(PyValueError::new_err(format!(
+            "{name}: expected shape (n, 3), got {shape:?}"
+        ))),
     }
-    Ok(view
-        .rows()
-        .into_iter()
-        .map(|r| [r[0], r[1], r[2]])
-        .collect())
 }
 
 /// Reads a volume file (NIfTI, NRRD, MetaImage, NumPy, a DICOM directory, raw with `dims` and
-/// `dtype`, or raw with a JSON sidecar). Returns `(volume, spacing, origin)`: a C-ordered array
-/// of shape `(nz, ny, nx)`, spacing and origin as `(x, y, z)`. A rescale slope/intercept in the
-/// file is applied (to float32 for 8- and 16-bit samples, float64 otherwise).
+/// `dtype`, or raw with a JSON sidecar). Returns `(volume, affine, space)`: a C-ordered array of
+/// shape `(nz, ny, nx)`, the 4×4 map from `(x, y, z, 1)` index to world coordinates, and the
+/// world's convention (`"RAS"`, `"LPS"`, or `None` for a file without a world frame). A rescale
+/// slope/intercept in the file is applied (to float32 for 8- and 16-bit samples, float64
+/// otherwise).
 #[pyfunction]
 #[pyo3(signature = (path, *, dims=None, dtype=None, endian="little", header_bytes=0, array=None, series=None, resample_gaps=false, zarr_level=0))]
 #[allow(clippy::too_many_arguments)]
@@ -137,11 +141,10 @@ pub fn load<'py>(
     let grid = py
         .detach(|| sc_io::read::read(&path, &options, &Silent))
         .map_err(errors::io)?;
+    let (affine, space) = world::affine(py, &grid)?;
     let Grid {
         samples,
         dims: [nx, ny, nz],
-        spacing,
-        origin,
         scale,
         ..
     } = grid;
@@ -151,7 +154,7 @@ pub fn load<'py>(
         with_samples!(&samples, v => rescaled(v, scale))
     };
     let volume = with_samples!(samples, v => PyArray1::from_vec(py, v.into_vec()).reshape([nz, ny, nx])?.into_any());
-    (volume, spacing, origin).into_pyobject(py)
+    (volume, affine, space).into_pyobject(py)
 }
 
 fn rescaled<T: Sample>(v: &[T], map: Linear) -> Samples {

@@ -11,6 +11,7 @@ mod recycle;
 mod shards;
 mod skimage;
 mod streamer;
+mod world;
 
 use pyo3::prelude::*;
 

@@ -97,7 +97,7 @@ impl SliceStreamer {
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let (mesh, stats) = self.join(py)?;
         let [nx, ny, nz] = self.dims;
-        let stats = extract::stats(py, &stats, &self.mode, self.level, [nx, ny, nz])?;
+        let stats = extract::stats(py, &stats, &self.mode, self.level, [nx, ny, nz], None)?;
         let normals = if self.normals {
             Some(convert::rows(py, mesh.normals)?)
         } else {

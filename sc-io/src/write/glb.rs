@@ -6,9 +6,7 @@
 
 use std::io::{self, Write};
 
-use sc_runtime::Mesh;
-
-use super::{WriteOptions, le_words};
+use super::{MeshSlices, WriteOptions, le_words};
 use crate::space::Space;
 use serde_json::{Value, json};
 
@@ -19,7 +17,12 @@ const UNSIGNED_INT: u32 = 5125;
 const TRIANGLES: u32 = 4;
 
 /// Writes the GLB header, the JSON chunk and the binary chunk.
-pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mesh = mesh.into();
     let too_big = || {
         io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -41,15 +44,15 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
     if bin_len > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
-        le_words(&mesh.positions, out, f32::to_le_bytes)?;
-        le_words(&mesh.normals, out, f32::to_le_bytes)?;
-        le_words(&mesh.triangles, out, u32::to_le_bytes)?;
+        le_words(mesh.positions, out, f32::to_le_bytes)?;
+        le_words(mesh.normals, out, f32::to_le_bytes)?;
+        le_words(mesh.triangles, out, u32::to_le_bytes)?;
     }
     Ok(())
 }
 
 /// The JSON document and the binary chunk's length (a multiple of 4, as every part is).
-fn document(mesh: &Mesh, options: &WriteOptions) -> (Value, usize) {
+fn document(mesh: MeshSlices<'_>, options: &WriteOptions) -> (Value, usize) {
     let asset = json!({
         "version": "2.0",
         "generator": "skelclimb (Skeleton Climbing)",
@@ -66,7 +69,7 @@ fn document(mesh: &Mesh, options: &WriteOptions) -> (Value, usize) {
     let index_bytes = 12 * mesh.triangles.len();
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
-    for p in &mesh.positions {
+    for p in mesh.positions {
         for a in 0..3 {
             lo[a] = lo[a].min(p[a]);
             hi[a] = hi[a].max(p[a]);
@@ -130,6 +133,8 @@ fn node(options: &WriteOptions) -> Value {
 
 #[cfg(test)]
 mod tests {
+    use sc_runtime::Mesh;
+
     use super::*;
     use crate::write::test_mesh::tetrahedron;
 

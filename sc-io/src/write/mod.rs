@@ -33,6 +33,28 @@ impl WriteOptions {
     }
 }
 
+/// A mesh's arrays, borrowed: all the writers read. A [`Mesh`] lends its own; a front end that
+/// holds the arrays elsewhere (NumPy's, in Python) lends those, so that writing copies nothing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MeshSlices<'a> {
+    /// Vertex positions.
+    pub positions: &'a [[f32; 3]],
+    /// Unit normals, one per position, or empty.
+    pub normals: &'a [[f32; 3]],
+    /// Triangles as indices into `positions`, each below `positions.len()`.
+    pub triangles: &'a [[u32; 3]],
+}
+
+impl<'a> From<&'a Mesh> for MeshSlices<'a> {
+    fn from(mesh: &'a Mesh) -> Self {
+        MeshSlices {
+            positions: &mesh.positions,
+            normals: &mesh.normals,
+            triangles: &mesh.triangles,
+        }
+    }
+}
+
 /// The mesh formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MeshFormat {
@@ -64,13 +86,15 @@ impl MeshFormat {
         }
     }
 
-    /// Writes `mesh`, recording its coordinate system where the format has room for it.
-    pub fn write(
+    /// Writes `mesh` (a [`Mesh`] or [`MeshSlices`]), recording its coordinate system where the
+    /// format has room for it.
+    pub fn write<'a>(
         self,
-        mesh: &Mesh,
+        mesh: impl Into<MeshSlices<'a>>,
         options: &WriteOptions,
         out: &mut impl Write,
     ) -> io::Result<()> {
+        let mesh = mesh.into();
         match self {
             MeshFormat::Ply if options.ascii => ply::write_ascii(mesh, options, out),
             MeshFormat::Ply => ply::write_binary(mesh, options, out),

@@ -2,13 +2,16 @@
 
 use std::io::{self, Write};
 
-use sc_runtime::Mesh;
-
-use super::WriteOptions;
 use super::text::Lines;
+use super::{MeshSlices, WriteOptions};
 
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.
-pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mesh = mesh.into();
     writeln!(
         out,
         "# skelclimb (Skeleton Climbing): {} vertices, {} triangles\n# coordinates: {}",
@@ -17,7 +20,7 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
         options.coordinates()
     )?;
     let mut lines = Lines::new(out);
-    for (tag, vectors) in [("v ", &mesh.positions), ("vn ", &mesh.normals)] {
+    for (tag, vectors) in [("v ", mesh.positions), ("vn ", mesh.normals)] {
         for &[x, y, z] in vectors {
             lines
                 .text(tag)
@@ -30,7 +33,7 @@ pub fn write(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::R
         }
     }
     let with_normals = !mesh.normals.is_empty();
-    for t in &mesh.triangles {
+    for t in mesh.triangles {
         lines.text("f");
         for i in t.map(|i| u64::from(i) + 1) {
             lines.text(" ").int(i);

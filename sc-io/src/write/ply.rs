@@ -2,13 +2,11 @@
 
 use std::io::{self, Write};
 
-use sc_runtime::Mesh;
-
 use super::text::Lines;
-use super::{WriteOptions, in_chunks, le_words};
+use super::{MeshSlices, WriteOptions, in_chunks, le_words};
 
 fn header(
-    mesh: &Mesh,
+    mesh: MeshSlices<'_>,
     format: &str,
     options: &WriteOptions,
     out: &mut impl Write,
@@ -33,12 +31,17 @@ fn header(
 /// Binary little-endian PLY. Records are encoded into a buffer a few thousand at a time and
 /// written in one call each: writing them field by field through the `BufWriter` cost as much as
 /// a quarter of the whole extraction.
-pub fn write_binary(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write_binary<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mesh = mesh.into();
     header(mesh, "binary_little_endian", options, out)?;
     let with_normals = !mesh.normals.is_empty();
     if !with_normals {
         // Positions alone are the file's records.
-        le_words(&mesh.positions, out, f32::to_le_bytes)?;
+        le_words(mesh.positions, out, f32::to_le_bytes)?;
     } else {
         let vertex_bytes = if with_normals { 24 } else { 12 };
         in_chunks(mesh.positions.len(), vertex_bytes, out, |i, rec| {
@@ -63,7 +66,12 @@ fn put_floats(rec: &mut [u8], values: &[f32; 3]) {
 }
 
 /// ASCII PLY; floats are printed in their shortest exact form, so nothing is lost.
-pub fn write_ascii(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) -> io::Result<()> {
+pub fn write_ascii<'a>(
+    mesh: impl Into<MeshSlices<'a>>,
+    options: &WriteOptions,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mesh = mesh.into();
     header(mesh, "ascii", options, out)?;
     let mut lines = Lines::new(out);
     for (i, [x, y, z]) in mesh.positions.iter().enumerate() {
@@ -79,7 +87,7 @@ pub fn write_ascii(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) ->
         }
         lines.end()?;
     }
-    for [a, b, c] in &mesh.triangles {
+    for [a, b, c] in mesh.triangles {
         lines
             .text("3 ")
             .int(u64::from(*a))
@@ -94,6 +102,8 @@ pub fn write_ascii(mesh: &Mesh, options: &WriteOptions, out: &mut impl Write) ->
 mod tests {
     use ply_rs::parser::Parser;
     use ply_rs::ply::{DefaultElement, Property};
+
+    use sc_runtime::Mesh;
 
     use super::*;
     use crate::write::test_mesh::tetrahedron;

@@ -2,12 +2,11 @@
 
 use std::io::{self, Write};
 
-use sc_runtime::Mesh;
-
-use super::in_chunks;
+use super::{MeshSlices, in_chunks};
 
 /// Writes the 80-byte header, the triangle count and one 50-byte record per triangle.
-pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+pub fn write<'a>(mesh: impl Into<MeshSlices<'a>>, out: &mut impl Write) -> io::Result<()> {
+    let mesh = mesh.into();
     let mut header = [b' '; 80];
     let title = b"skelclimb (Skeleton Climbing) binary STL";
     header[..title.len()].copy_from_slice(title);

@@ -11,12 +11,15 @@ Two entry points:
 
 * :func:`extract` is this package's own call: vertices in ``(x, y, z)`` order, where ``x`` is the
   fastest-varying axis in memory (the last axis of a C-ordered array), spacing and origin in the
-  same order. This is how the ``skelclimb`` command reads NumPy files.
+  same order. This is how the ``skelclimb`` command reads NumPy files. With the ``affine`` that
+  :func:`load` returns, the vertices land in the scanner's world, where the command puts them.
 * :func:`marching_cubes` is a drop-in for ``skimage.measure.marching_cubes``: vertices in the
   array's own axis order, the same winding, the same return value.
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple, Optional
 
 import numpy as np
 
@@ -25,6 +28,7 @@ from . import _native
 __all__ = [
     "BlockMesh",
     "Mesh",
+    "Scan",
     "SliceStreamer",
     "block_samples",
     "extract",
@@ -44,7 +48,8 @@ class Mesh:
     Attributes
     ----------
     vertices : (V, 3) float32 array
-        Positions, ``(x, y, z)`` in world units (index × spacing + origin).
+        Positions, ``(x, y, z)``: in the scanner's world when made with an ``affine``, otherwise
+        index × spacing + origin.
     faces : (T, 3) uint32 array
         Vertex indices, wound so that ``(b - a) × (c - a)`` points out of the region
         ``volume >= level``.
@@ -52,7 +57,10 @@ class Mesh:
         Unit normals pointing out of that region, if asked for.
     stats : dict
         ``steps123`` and ``result`` (vertex and triangle counts), ``merged``, ``blocked`` and
-        ``bounded`` grey edges (``bounded``: blocked by ``max_error`` alone), ``reduction_percent``, ``mode``, ``iso``, ``dims`` (``[nx, ny, nz]``).
+        ``bounded`` grey edges (``bounded``: blocked by ``max_error`` alone),
+        ``reduction_percent``, ``mode``, ``iso``, ``dims`` (``[nx, ny, nz]``), and ``space``: the
+        world convention of the vertices, ``"RAS"`` or ``"LPS"``, or None (index × spacing +
+        origin, or an affine given without a ``space``).
     """
 
     __slots__ = ("vertices", "faces", "normals", "stats")
@@ -70,7 +78,9 @@ class Mesh:
         """Writes the mesh to ``path``: ``.ply``, ``.obj``, ``.stl`` or ``.glb`` by extension.
 
         The file appears whole or not at all (it is written to a temporary file and renamed),
-        with the same writers as the ``skelclimb`` command.
+        with the same writers as the ``skelclimb`` command, straight from the arrays (C-ordered
+        ones are not copied). ``stats["space"]`` is recorded in the file as the command records
+        it.
 
         >>> mesh.save("ball.ply")  # doctest: +SKIP
         """
@@ -79,7 +89,7 @@ class Mesh:
         normals = None
         if self.normals is not None:
             normals = np.ascontiguousarray(self.normals, dtype=np.float32)
-        _native.save(str(path), vertices, faces, normals, ascii)
+        _native.save(str(path), vertices, faces, normals, ascii, self.stats.get("space"))
 
     def to_trimesh(self):
         """The mesh as a ``trimesh.Trimesh`` (needs the ``trimesh`` package)."""
@@ -156,27 +166,71 @@ def _bound(max_error, error_units):
 
 
 def _pad(volume, level):
-    """``volume`` with one layer around it that is empty at ``level``, so every surface closes."""
-    if np.issubdtype(volume.dtype, np.integer):
+    """``volume`` with one layer around it that is empty at ``level``, so every surface closes.
+
+    The fill is the command's: the smallest finite sample if it is empty, so caps sit where the
+    data puts them, otherwise the largest value of the type below ``level``.
+    """
+    finite = volume if np.issubdtype(volume.dtype, np.integer) else volume[np.isfinite(volume)]
+    low = finite.min() if finite.size else None
+    if low is not None and low < level:
+        fill = low
+    elif np.issubdtype(volume.dtype, np.integer):
         below = np.ceil(level) - 1
         info = np.iinfo(volume.dtype)
         if below < info.min:
             raise ValueError(f"pad: no {volume.dtype} value is below level {level}")
         fill = volume.dtype.type(min(below, info.max))
     else:
-        finite = volume[np.isfinite(volume)]
-        low = finite.min() if finite.size else level
-        fill = low if low < level else np.nextafter(volume.dtype.type(level), -np.inf)
+        fill = volume.dtype.type(level)
+        if not fill < level:
+            fill = np.nextafter(fill, volume.dtype.type(-np.inf))
     order = "F" if volume.flags.f_contiguous and not volume.flags.c_contiguous else "C"
     return np.pad(volume, 1, constant_values=fill), order
+
+
+def _affine(affine, spacing, origin):
+    """``affine`` as a checked 4×4 float64 copy, or None; any ``spacing`` and ``origin`` given
+    beside it must agree with it."""
+    if affine is None:
+        return None
+    try:
+        affine = np.array(affine, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"affine: expected a 4×4 array of numbers, got {affine!r}") from None
+    if affine.shape != (4, 4):
+        raise ValueError(f"affine: expected a 4×4 array, got shape {affine.shape}")
+    if not np.isfinite(affine).all():
+        raise ValueError(f"affine: must be finite, got\n{affine}")
+    if not np.array_equal(affine[3], [0, 0, 0, 1]):
+        raise ValueError(f"affine: the last row must be (0, 0, 0, 1), got {affine[3]}")
+    # A spacing or origin beside the affine is allowed only if it says the same.
+    lengths = np.linalg.norm(affine[:3, :3], axis=0)
+    if spacing is not None and not np.allclose(
+        _triple(spacing, "spacing"), lengths, rtol=1e-6, atol=0
+    ):
+        raise ValueError(
+            f"spacing: {tuple(spacing)} contradicts the affine's column lengths {tuple(lengths)}; "
+            "give the affine alone"
+        )
+    if origin is not None and not np.allclose(
+        _triple(origin, "origin"), affine[:3, 3], rtol=1e-9, atol=1e-6
+    ):
+        raise ValueError(
+            f"origin: {tuple(origin)} contradicts the affine's translation "
+            f"{tuple(affine[:3, 3])}; give the affine alone"
+        )
+    return affine
 
 
 def extract(
     volume,
     level,
     *,
-    spacing=(1, 1, 1),
-    origin=(0, 0, 0),
+    affine=None,
+    space=None,
+    spacing=None,
+    origin=None,
     mode="embedded",
     pad=False,
     normals=True,
@@ -196,8 +250,20 @@ def extract(
         non-native byte order.
     level : float
         The iso value. Integer volumes are compared exactly in their own type.
+    affine : (4, 4) array, optional
+        The map from sample index ``(x, y, z, 1)`` to the scanner's world, as :func:`load`
+        returns it: ``x`` is the last axis of a C-ordered array, the first of a Fortran-ordered
+        one (so nibabel's ``img.affine`` fits ``np.asfortranarray(img.get_fdata())``). Vertices
+        and normals are mapped into that world exactly as the ``skelclimb`` command maps them (a
+        mirroring affine reverses the winding, so that faces still point out). It must be finite
+        and invertible with ``(0, 0, 0, 1)`` as its last row.
+    space : ``"RAS"``, ``"LPS"`` or None
+        The world's convention, recorded in ``stats["space"]`` and in saved files; :func:`load`
+        returns it beside the affine.
     spacing, origin : three floats, ``(x, y, z)``
-        Vertex positions are ``index × spacing + origin``.
+        Without an affine, vertex positions are ``index × spacing + origin`` (by default
+        ``(1, 1, 1)`` and ``(0, 0, 0)``). Beside an affine they must agree with its column
+        lengths and translation.
     mode : ``"embedded"`` (default), ``"paper"`` or ``"steps123"``
         ``embedded`` merges only where the surface stays a closed 2-manifold, ``paper`` merges
         every interior grey edge as the paper does, ``steps123`` does not merge (the Marching
@@ -230,11 +296,19 @@ def extract(
     >>> m = skelclimb.extract(v, 1)
     >>> m.stats["result"]["triangles"] < m.stats["steps123"]["triangles"]
     True
+
+    An affine that swaps x and y (a mirror) moves the vertices and keeps the faces outward:
+
+    >>> swap = np.array([[0, 2, 0, 10], [2, 0, 0, 0], [0, 0, 2, 0], [0, 0, 0, 1]])
+    >>> w = skelclimb.extract(v, 1, affine=swap, space="RAS")
+    >>> np.allclose(w.vertices, m.vertices[:, [1, 0, 2]] * 2 + [10, 0, 0]), w.stats["space"]
+    (True, 'RAS')
     """
     volume = _volume(volume)
     level = _level(level)
-    spacing = _triple(spacing, "spacing")
-    origin = _triple(origin, "origin")
+    affine = _affine(affine, spacing, origin)
+    spacing = _triple((1, 1, 1) if spacing is None else spacing, "spacing")
+    origin = _triple((0, 0, 0) if origin is None else origin, "origin")
     if mode not in _MODES:
         raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
     threads = int(threads)
@@ -243,12 +317,39 @@ def extract(
     if pad:
         volume, order = _pad(volume, level)
         volume = np.asarray(volume, order=order)
+        # Sample (0, 0, 0) is now one step back along each axis.
         origin = tuple(o - s for o, s in zip(origin, spacing))
+        if affine is not None:
+            affine[:3, 3] -= affine[:3, :3].sum(axis=1)
     verts, faces, norms, stats = _native.extract(
         volume, level, spacing, origin, mode, bool(normals), threads,
-        _bound(max_error, error_units),
+        _bound(max_error, error_units), None if affine is None else affine[:3].tolist(), space,
     )
     return Mesh(verts, faces, norms, stats)
+
+
+class Scan(NamedTuple):
+    """A volume read by :func:`load`, and where it sits in the scanner's world.
+
+    Unpacks as ``volume, affine, space = skelclimb.load(path)``.
+    """
+
+    volume: np.ndarray
+    """The samples, C-ordered, of shape ``(nz, ny, nx)``."""
+    affine: np.ndarray
+    """(4, 4) float64: sample index ``(x, y, z, 1)`` (``x`` the last array axis) to world."""
+    space: Optional[str]
+    """The world's convention, ``"RAS"`` or ``"LPS"``, or None for a file without one."""
+
+    @property
+    def spacing(self):
+        """The distance between samples along x, y and z: the affine's column lengths."""
+        return tuple(float(v) for v in np.linalg.norm(self.affine[:3, :3], axis=0))
+
+    @property
+    def origin(self):
+        """Where sample ``(0, 0, 0)`` sits in the world: the affine's translation."""
+        return tuple(float(v) for v in self.affine[:3, 3])
 
 
 def load(path, **options):
@@ -262,17 +363,26 @@ def load(path, **options):
     ``header_bytes=``), or raw samples with a JSON sidecar. For Zarr stores larger than memory,
     use :func:`skelclimb.dask.extract`.
 
-    Returns ``(volume, spacing, origin)``: a C-ordered array of shape ``(nz, ny, nx)``, and spacing
-    and origin as ``(x, y, z)``, ready for :func:`extract`. A rescale slope and intercept in the
-    file are applied.
+    Returns a :class:`Scan` ``(volume, affine, space)``:
 
-    >>> vol, spacing, origin = skelclimb.load("head.nii.gz")  # doctest: +SKIP
-    >>> mesh = skelclimb.extract(vol, 300, spacing=spacing, origin=origin)  # doctest: +SKIP
+    * ``volume``: a C-ordered array of shape ``(nz, ny, nx)``, with any rescale slope and
+      intercept in the file applied;
+    * ``affine``: the 4×4 map from sample index ``(x, y, z, 1)`` to world coordinates, as the
+      file states it (NIfTI sform or qform, NRRD space directions, MetaImage TransformMatrix,
+      DICOM orientation and position; index × spacing + origin for raw and NumPy files);
+    * ``space``: the convention of that world as the file states it, ``"RAS"`` (NIfTI, NRRD in
+      RAS space) or ``"LPS"`` (DICOM, MetaImage, most NRRD), or None for a file without one.
+
+    Given to :func:`extract`, the affine and space put the mesh where the ``skelclimb``
+    command puts it. ``Scan.spacing`` and ``Scan.origin`` are the affine's column lengths and
+    translation.
+
+    >>> volume, affine, space = skelclimb.load("head.nii.gz")  # doctest: +SKIP
+    >>> mesh = skelclimb.extract(volume, 300, affine=affine, space=space)  # doctest: +SKIP
     """
     if "dims" in options and options["dims"] is not None:
         options["dims"] = tuple(int(d) for d in options["dims"])
-    volume, spacing, origin = _native.load(str(path), **options)
-    return volume, tuple(spacing), tuple(origin)
+    return Scan(*_native.load(str(path), **options))
 
 
 class SliceStreamer:

@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Literal, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -7,6 +7,7 @@ import numpy.typing as npt
 _Mode = Literal["embedded", "paper", "steps123"]
 _Triple = Sequence[float]
 _Path = Union[str, PathLike]
+_Space = Optional[Literal["RAS", "LPS"]]
 
 class Mesh:
     vertices: npt.NDArray[np.float32]
@@ -28,8 +29,10 @@ def extract(
     volume: npt.NDArray[Any],
     level: float,
     *,
-    spacing: _Triple = ...,
-    origin: _Triple = ...,
+    affine: Optional[npt.ArrayLike] = ...,
+    space: _Space = ...,
+    spacing: Optional[_Triple] = ...,
+    origin: Optional[_Triple] = ...,
     mode: _Mode = ...,
     pad: bool = ...,
     normals: bool = ...,
@@ -54,6 +57,15 @@ def marching_cubes(
     npt.NDArray[np.float32],
     npt.NDArray[np.float32],
 ]: ...
+class Scan(NamedTuple):
+    volume: npt.NDArray[Any]
+    affine: npt.NDArray[np.float64]
+    space: _Space
+    @property
+    def spacing(self) -> Tuple[float, float, float]: ...
+    @property
+    def origin(self) -> Tuple[float, float, float]: ...
+
 def load(
     path: _Path,
     *,
@@ -65,7 +77,7 @@ def load(
     series: Optional[str] = ...,
     resample_gaps: bool = ...,
     zarr_level: int = ...,
-) -> Tuple[npt.NDArray[Any], Tuple[float, float, float], Tuple[float, float, float]]: ...
+) -> Scan: ...
 
 class SliceStreamer:
     def __init__(

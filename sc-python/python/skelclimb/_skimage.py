@@ -55,8 +55,9 @@ def marching_cubes(
     method : ``'lewiner'`` or ``'lorensen'``
         Checked, otherwise ignored: the surface is always Skeleton Climbing's.
     mask : (M, N, P) bool ndarray, optional
-        Keep only triangles in cubes whose lower corner is True, as scikit-image does. A merged
-        triangle spans two cubes and is kept when the cube holding its centroid is.
+        Keep only triangles in cubes whose upper corner (the largest index along every axis) is
+        True, as scikit-image does. A merged triangle spans two cubes and is kept when the cube
+        holding its centroid is.
     threads : int
         Not in scikit-image: worker threads, 0 for all cores (the result is the same).
 
@@ -140,12 +141,14 @@ def marching_cubes(
 
 
 def _masked(faces, index, mask):
-    """The faces whose centroid lies in a cube whose lower corner is True in ``mask``."""
+    """The faces whose centroid lies in a cube whose upper corner is True in ``mask``: cube
+    ``(i, j, k)`` spans samples ``i..i+1`` (and so on), and scikit-image meshes it when
+    ``mask[i + 1, j + 1, k + 1]`` is set."""
     centroid = index[faces].mean(axis=1)
     cube = np.floor(centroid).astype(np.int64)
-    upper = np.asarray(mask.shape) - 2
-    cube = np.clip(cube, 0, upper)
-    return faces[mask[cube[:, 0], cube[:, 1], cube[:, 2]]]
+    cube = np.clip(cube, 0, np.asarray(mask.shape) - 2)
+    corner = cube + 1
+    return faces[mask[corner[:, 0], corner[:, 1], corner[:, 2]]]
 
 
 def _compact(verts, faces, normals, values):
