@@ -22,10 +22,10 @@ mod scalar;
 pub mod tables;
 
 pub use error::Error;
-pub use params::{Axes, ErrorBound, Mode, Params, Volume};
+pub use params::{Axes, ErrorBound, ErrorUnits, Mode, Params, UnknownName, Volume};
 pub use scalar::Scalar;
 mod stats;
-pub use stats::Stats;
+pub use stats::{Figure, Stats};
 
 #[cfg(feature = "alloc")]
 mod mesh;

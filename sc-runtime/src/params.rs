@@ -12,6 +12,81 @@ pub enum Mode {
     Steps123,
 }
 
+impl Mode {
+    /// Every mode, in declaration order.
+    pub const ALL: [Mode; 3] = [Mode::Embedded, Mode::Paper, Mode::Steps123];
+
+    /// The modes' names, in the order of [`Mode::ALL`]: the one spelling that the command
+    /// line, Python, shard manifests and reports share.
+    pub const NAMES: [&'static str; 3] = ["embedded", "paper", "steps123"];
+
+    /// This mode's name (see [`Mode::NAMES`]).
+    pub const fn name(self) -> &'static str {
+        Mode::NAMES[self as usize]
+    }
+}
+
+impl core::fmt::Display for Mode {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl core::str::FromStr for Mode {
+    type Err = UnknownName;
+
+    /// The mode named `name` (one of [`Mode::NAMES`], exactly).
+    fn from_str(name: &str) -> Result<Mode, UnknownName> {
+        parse_name(name, &Mode::NAMES, &Mode::ALL)
+    }
+}
+
+/// A name missing from a table of names ([`Mode::NAMES`], [`ErrorUnits::NAMES`]); its message
+/// lists the names that are valid, for a front end to put beside the name it was given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnknownName {
+    expected: &'static [&'static str],
+}
+
+impl UnknownName {
+    /// The valid names.
+    pub fn expected(&self) -> &'static [&'static str] {
+        self.expected
+    }
+}
+
+/// "expected 'a', 'b' or 'c'".
+impl core::fmt::Display for UnknownName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("expected ")?;
+        let last = self.expected.len().saturating_sub(1);
+        for (i, name) in self.expected.iter().enumerate() {
+            let sep = match i {
+                0 => "",
+                _ if i == last => " or ",
+                _ => ", ",
+            };
+            write!(f, "{sep}'{name}'")?;
+        }
+        Ok(())
+    }
+}
+
+impl core::error::Error for UnknownName {}
+
+/// The value whose name in `names` is `name`; `values` is in the order of `names`.
+fn parse_name<T: Copy>(
+    name: &str,
+    names: &'static [&'static str],
+    values: &[T],
+) -> Result<T, UnknownName> {
+    names
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| values[i])
+        .ok_or(UnknownName { expected: names })
+}
+
 /// The order of the coordinates of each position and normal a sweep emits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Axes {
@@ -33,6 +108,70 @@ pub enum ErrorBound {
     World(f64),
     /// In grid steps: distances measured on sample indices, whatever the spacing.
     Voxels(f64),
+}
+
+impl ErrorBound {
+    /// A bound of `value` in `units`.
+    pub fn new(value: f64, units: ErrorUnits) -> ErrorBound {
+        match units {
+            ErrorUnits::World => ErrorBound::World(value),
+            ErrorUnits::Voxels => ErrorBound::Voxels(value),
+        }
+    }
+
+    /// The bound's number, in its units.
+    pub fn value(self) -> f64 {
+        match self {
+            ErrorBound::World(d) | ErrorBound::Voxels(d) => d,
+        }
+    }
+
+    /// The units the bound is in.
+    pub fn units(self) -> ErrorUnits {
+        match self {
+            ErrorBound::World(_) => ErrorUnits::World,
+            ErrorBound::Voxels(_) => ErrorUnits::Voxels,
+        }
+    }
+}
+
+/// The units of an [`ErrorBound`], without its number: what a front end parses from a name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ErrorUnits {
+    /// World units (see [`ErrorBound::World`]).
+    #[default]
+    World,
+    /// Grid steps (see [`ErrorBound::Voxels`]).
+    Voxels,
+}
+
+impl ErrorUnits {
+    /// Both units, in declaration order.
+    pub const ALL: [ErrorUnits; 2] = [ErrorUnits::World, ErrorUnits::Voxels];
+
+    /// The units' names, in the order of [`ErrorUnits::ALL`], as the command line, Python,
+    /// shard manifests and reports spell them.
+    pub const NAMES: [&'static str; 2] = ["world", "voxels"];
+
+    /// These units' name (see [`ErrorUnits::NAMES`]).
+    pub const fn name(self) -> &'static str {
+        ErrorUnits::NAMES[self as usize]
+    }
+}
+
+impl core::fmt::Display for ErrorUnits {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl core::str::FromStr for ErrorUnits {
+    type Err = UnknownName;
+
+    /// The units named `name` (one of [`ErrorUnits::NAMES`], exactly).
+    fn from_str(name: &str) -> Result<ErrorUnits, UnknownName> {
+        parse_name(name, &ErrorUnits::NAMES, &ErrorUnits::ALL)
+    }
 }
 
 /// Everything about an extraction besides the samples.
@@ -114,5 +253,31 @@ impl<'a, T: Scalar> Volume<'a, T> {
     /// `[nx, ny, nz]`.
     pub fn dims(&self) -> [usize; 3] {
         self.dims
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::string::ToString;
+
+    #[test]
+    fn names_round_trip_and_unknown_names_list_the_valid_ones() {
+        for (i, mode) in Mode::ALL.into_iter().enumerate() {
+            assert_eq!(mode.name(), Mode::NAMES[i]);
+            assert_eq!(mode.to_string(), Mode::NAMES[i]);
+            assert_eq!(mode.name().parse(), Ok(mode));
+        }
+        for (i, units) in ErrorUnits::ALL.into_iter().enumerate() {
+            assert_eq!(units.name(), ErrorUnits::NAMES[i]);
+            assert_eq!(units.name().parse(), Ok(units));
+            let bound = ErrorBound::new(0.5, units);
+            assert_eq!((bound.value(), bound.units()), (0.5, units));
+        }
+        let e = "Paper".parse::<Mode>().unwrap_err();
+        assert_eq!(e.expected(), &Mode::NAMES[..]);
+        assert_eq!(e.to_string(), "expected 'embedded', 'paper' or 'steps123'");
+        let e = "mm".parse::<ErrorUnits>().unwrap_err();
+        assert_eq!(e.to_string(), "expected 'world' or 'voxels'");
     }
 }
