@@ -29,6 +29,7 @@ pub mod error;
 pub mod mesh_in;
 pub mod progress;
 pub mod read;
+pub mod report;
 pub mod shard;
 pub mod space;
 #[cfg(feature = "surface")]

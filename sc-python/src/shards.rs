@@ -86,7 +86,7 @@ pub fn write_manifest(
 pub fn merge_shards<'py>(py: Python<'py>, manifest: PathBuf) -> PyResult<Bound<'py, PyTuple>> {
     let (manifest, mesh) = py.detach(|| shard::merge(&manifest)).map_err(errors::io)?;
     let s = &manifest.settings;
-    let stats = crate::extract::stats(py, &mesh.stats, s.mode_name(), s.iso, manifest.grid)?;
+    let stats = crate::extract::stats(py, &mesh.stats, s.mode.name(), s.iso, manifest.grid)?;
     let normals = match s.normals {
         true => Some(convert::rows(py, mesh.normals)?),
         false => None,

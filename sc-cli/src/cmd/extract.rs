@@ -9,7 +9,7 @@ use sc_runtime::{Mesh, Mode};
 use super::warn;
 use crate::builtin;
 use crate::check::EdgeReport;
-use crate::cli::{Demo, ExtractArgs, ModeArg};
+use crate::cli::{Demo, ExtractArgs};
 use crate::progress::{Bar, Counted};
 use crate::summary::Summary;
 use sc_io::atomic::AtomicFile;
@@ -138,7 +138,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         args.demo == Some(Demo::Knot) && args.size == 64 && args.iso.is_none_or(|i| i == iso);
     let paper_knot = match args.mode {
         _ if !is_paper_knot => None,
-        ModeArg::Paper => Some(mesh.stats.triangles),
+        Mode::Paper => Some(mesh.stats.triangles),
         _ => {
             // Table 1's figure, without any --max-error.
             let request = Request {
@@ -175,7 +175,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         coordinates: world.describe(),
         dtype: grid.samples.dtype().name(),
         iso,
-        mode: args.mode.into(),
+        mode: args.mode,
         max_error: args.error_bound(),
         stats: mesh.stats,
         read: read_time,
@@ -219,7 +219,7 @@ fn load(
 fn request(args: &ExtractArgs, iso: f64) -> Request {
     Request {
         iso,
-        mode: args.mode.into(),
+        mode: args.mode,
         normals: !args.no_normals,
         threads: args.threads,
         coordinates: args.space,
