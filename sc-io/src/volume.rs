@@ -216,7 +216,7 @@ fn dtype_of<T: Sample>(_: &[T]) -> Dtype {
 }
 
 /// What the readers and the padding need of a sample type beyond what the extractor needs.
-pub trait Sample: Scalar + Pod + PartialOrd + crate::read::zarr::Element {
+pub trait Sample: Scalar + Pod + PartialOrd {
     /// The matching [`Dtype`].
     const DTYPE: Dtype;
     /// Wraps typed samples.
