@@ -2,8 +2,9 @@
 
 use std::path::Path;
 
+use super::block::{Block, Start, read_block};
+use super::format::RawLayout;
 use super::payload::{Encoding, Layout};
-use super::{Block, RawLayout, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::volume::Grid;

@@ -6,8 +6,11 @@
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
+use super::block::{Block, MAX_TRAILING, Start, block_error, open_block};
+use super::format::{Format, ReadOptions};
 use super::payload::{self, Encoding, Layout};
-use super::{Block, Format, ReadOptions, block_error, nifti, open_block, raw, sidecar, zarr};
+use super::placement::check_placement;
+use super::{nifti, raw, sidecar, zarr};
 use crate::error::{Error, Result};
 use crate::progress::{Progress, Silent};
 use crate::volume::{Grid, Sample, Samples};
@@ -69,7 +72,7 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
         }
         Format::Zarr => {
             let (grid, source) = zarr::open(path, options.zarr_level)?;
-            super::check_placement(path, &grid)?;
+            check_placement(path, &grid)?;
             return Ok(Some(Stream {
                 grid,
                 path: path.to_path_buf(),
@@ -80,7 +83,7 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
         _ => return Ok(None),
     };
     grid.format = format.name();
-    super::check_placement(path, &grid)?;
+    check_placement(path, &grid)?;
     Ok(Some(Stream {
         source: Source::Block {
             reader: open_block(&block)?,
@@ -131,8 +134,7 @@ impl Stream {
                     payload::read_typed::<T>(&mut *reader, slab, false, &Silent).map_err(error)?;
                 if z1 == nz && *encoding != Encoding::Raw {
                     // As a whole read does: read on to make the decoder check the gzip CRC.
-                    io::copy(&mut reader.take(super::MAX_TRAILING), &mut io::sink())
-                        .map_err(error)?;
+                    io::copy(&mut reader.take(MAX_TRAILING), &mut io::sink()).map_err(error)?;
                 }
                 samples
             }
@@ -164,7 +166,7 @@ impl Stream {
 fn block_at(path: &Path, encoding: Encoding, layout: Layout) -> Block<'_> {
     Block {
         path,
-        start: super::Start::At(0),
+        start: Start::At(0),
         skip_lines: 0,
         encoding,
         skip_decoded: 0,
