@@ -38,11 +38,11 @@ use crate::report;
 use crate::space::{Space, World};
 
 /// The `format` field of a manifest.
-pub const MANIFEST_FORMAT: &str = "skelclimb-shards";
+const MANIFEST_FORMAT: &str = "skelclimb-shards";
 /// The `format` field of a shard's header.
-pub const SHARD_FORMAT: &str = "skelclimb-shard";
+const SHARD_FORMAT: &str = "skelclimb-shard";
 /// The version of both; a reader refuses others rather than guess.
-pub const VERSION: u64 = 1;
+const VERSION: u64 = 1;
 /// The manifest's file name inside a shard directory.
 pub const MANIFEST_NAME: &str = "manifest.json";
 
@@ -588,7 +588,7 @@ fn read_checked(path: &Path, entry: &ShardEntry, manifest: &Manifest) -> Result<
 }
 
 /// Where the shard `entry` of the manifest at `manifest_path` is.
-pub fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
+fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
     manifest_path
         .parent()
         .unwrap_or(Path::new(""))

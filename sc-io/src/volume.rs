@@ -149,7 +149,6 @@ macro_rules! with_samples {
 }
 
 /// Runs `$body` with the type alias `$t` set to the Rust type of a [`Dtype`].
-#[macro_export]
 macro_rules! with_dtype {
     ($dtype:expr, $t:ident => $body:expr) => {
         match $dtype {
@@ -188,6 +187,8 @@ macro_rules! with_dtype {
         }
     };
 }
+
+pub(crate) use with_dtype;
 
 impl Samples {
     /// The stored type.

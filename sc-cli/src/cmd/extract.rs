@@ -13,12 +13,12 @@ use crate::cli::{Demo, ExtractArgs};
 use crate::progress::{Bar, Counted};
 use crate::summary::Summary;
 use sc_io::atomic::AtomicFile;
-use sc_io::error::{Error, Result};
 use sc_io::progress::Progress;
 use sc_io::read::{self, Format, ReadOptions, stream};
 use sc_io::surface::{self, Request};
 use sc_io::volume::Grid;
 use sc_io::write::{MeshFormat, WriteOptions};
+use sc_io::{Error, Result};
 
 /// Whether the samples of `path` would take more than half the machine's memory, so that reading
 /// them slice by slice is the only sane way. Unknown sizes and memory (not Linux) say no.

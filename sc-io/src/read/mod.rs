@@ -1,26 +1,27 @@
-//! Volume readers. Each format parses its own header (with a crate where a good one exists) and
-//! hands the sample block to [`block::read_block`], so that byte order, compression, truncation
-//! and progress are handled once.
+//! Volume readers: [`read`] reads a file in whatever format it is, and [`stream`] reads raw,
+//! NIfTI and Zarr volumes a few slices at a time. Each format parses its own header (with a crate
+//! where a good one exists) and hands its sample block to one reader of blocks, so that byte
+//! order, compression, truncation and progress are handled once.
 
-pub mod block;
+mod block;
 pub mod dicom;
 mod dicom_lengths;
 mod format;
-pub mod header;
-pub mod metaimage;
-pub mod nifti;
-pub mod npy;
-pub mod nrrd;
-pub mod payload;
+mod header;
+mod metaimage;
+mod nifti;
+pub(crate) mod npy;
+mod nrrd;
+mod payload;
 mod placement;
-pub mod raw;
-pub mod sidecar;
+mod raw;
+mod sidecar;
 pub mod stream;
 #[cfg(feature = "zarr")]
-pub mod zarr;
+mod zarr;
 #[cfg(not(feature = "zarr"))]
 #[path = "zarr_off.rs"]
-pub mod zarr;
+mod zarr;
 
 use std::path::Path;
 

@@ -102,7 +102,7 @@ const SLAB_BYTES: usize = 16 << 20;
 
 impl Stream {
     /// z-slices per read that suit the source: a row of chunks for Zarr, about 16 MiB for files.
-    pub fn slab(&self) -> usize {
+    pub(crate) fn slab(&self) -> usize {
         match &self.source {
             Source::Zarr(z) => z.chunk_z().max(1),
             Source::Block { layout, .. } => {
@@ -113,7 +113,7 @@ impl Stream {
     }
 
     /// The next `slices` z-slices (fewer at the end), x fastest.
-    pub fn read<T: Sample>(&mut self, slices: usize) -> Result<Vec<T>> {
+    pub(crate) fn read<T: Sample>(&mut self, slices: usize) -> Result<Vec<T>> {
         let [nx, ny, nz] = self.grid.dims;
         let slices = slices.min(nz - self.read);
         let (z0, z1) = (self.read, self.read + slices);
@@ -144,7 +144,7 @@ impl Stream {
     }
 
     /// Every sample, for a whole read.
-    pub fn read_all(mut self, progress: &dyn Progress) -> Result<Grid> {
+    pub(crate) fn read_all(mut self, progress: &dyn Progress) -> Result<Grid> {
         let dtype = self.grid.samples.dtype();
         progress.phase("reading", self.grid.dims[2] as u64);
         let samples = crate::with_dtype!(dtype, T => {

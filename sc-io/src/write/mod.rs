@@ -1,10 +1,10 @@
 //! Mesh writers, chosen by the output file's extension. Each writes to any `Write`; the caller
 //! puts a temporary file behind it (see [`crate::atomic`]).
 
-pub mod glb;
-pub mod obj;
-pub mod ply;
-pub mod stl;
+mod glb;
+mod obj;
+mod ply;
+mod stl;
 mod text;
 
 use std::io::{self, Write};
