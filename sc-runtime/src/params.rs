@@ -1,5 +1,31 @@
 use crate::{Error, Scalar};
 
+/// `Display` and `FromStr` for a type with a table of names, `NAMES`, in the order of `ALL`:
+/// each value is written as its name, and parsed from exactly that name.
+macro_rules! named {
+    ($t:ident) => {
+        impl core::fmt::Display for $t {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl core::str::FromStr for $t {
+            type Err = UnknownName;
+
+            fn from_str(name: &str) -> Result<$t, UnknownName> {
+                $t::NAMES
+                    .iter()
+                    .position(|n| *n == name)
+                    .map(|i| $t::ALL[i])
+                    .ok_or(UnknownName {
+                        expected: &$t::NAMES,
+                    })
+            }
+        }
+    };
+}
+
 /// Which steps of Skeleton Climbing run (SPEC §5).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Mode {
@@ -26,20 +52,7 @@ impl Mode {
     }
 }
 
-impl core::fmt::Display for Mode {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl core::str::FromStr for Mode {
-    type Err = UnknownName;
-
-    /// The mode named `name` (one of [`Mode::NAMES`], exactly).
-    fn from_str(name: &str) -> Result<Mode, UnknownName> {
-        parse_name(name, &Mode::NAMES, &Mode::ALL)
-    }
-}
+named!(Mode);
 
 /// A name missing from a table of names ([`Mode::NAMES`], [`ErrorUnits::NAMES`]); its message
 /// lists the names that are valid, for a front end to put beside the name it was given.
@@ -73,19 +86,6 @@ impl core::fmt::Display for UnknownName {
 }
 
 impl core::error::Error for UnknownName {}
-
-/// The value whose name in `names` is `name`; `values` is in the order of `names`.
-fn parse_name<T: Copy>(
-    name: &str,
-    names: &'static [&'static str],
-    values: &[T],
-) -> Result<T, UnknownName> {
-    names
-        .iter()
-        .position(|n| *n == name)
-        .map(|i| values[i])
-        .ok_or(UnknownName { expected: names })
-}
 
 /// The order of the coordinates of each position and normal a sweep emits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -159,20 +159,7 @@ impl ErrorUnits {
     }
 }
 
-impl core::fmt::Display for ErrorUnits {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl core::str::FromStr for ErrorUnits {
-    type Err = UnknownName;
-
-    /// The units named `name` (one of [`ErrorUnits::NAMES`], exactly).
-    fn from_str(name: &str) -> Result<ErrorUnits, UnknownName> {
-        parse_name(name, &ErrorUnits::NAMES, &ErrorUnits::ALL)
-    }
-}
+named!(ErrorUnits);
 
 /// Everything about an extraction besides the samples.
 #[derive(Clone, Copy, Debug)]
