@@ -29,7 +29,7 @@
 //!   reading); [`volume`]: the grid and its typed samples; [`space`]: where it sits in the
 //!   scanner's world.
 //! - [`surface`]: the extraction of a grid (whole, streamed, or as [`shard`]s).
-//! - [`write`]: a mesh out, in the format its file name asks for, through an [`atomic`] file,
+//! - [`write`](mod@write): a mesh out, in the format its file name asks for, through an [`atomic`] file,
 //!   whole or not at all; [`mesh_in`]: a mesh read back, for comparisons.
 //! - [`report`]: the counts of an extraction as JSON; [`progress`]: how long-running work
 //!   tells how far it got.

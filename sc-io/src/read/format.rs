@@ -50,7 +50,7 @@ pub enum Format {
     Npz,
     /// A directory of DICOM slices.
     Dicom,
-    /// Raw samples described by a JSON sidecar (see [`sidecar`]).
+    /// Raw samples described by a JSON sidecar (`scan.json` next to `scan.raw`).
     Sidecar,
     /// A Zarr v2 or v3 array, or an OME-Zarr image (a directory).
     Zarr,
