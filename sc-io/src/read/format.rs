@@ -3,22 +3,9 @@
 
 use std::path::Path;
 
+use super::raw::RawLayout;
 use super::{dicom, sidecar};
 use crate::error::{Error, Result};
-use crate::volume::{Dtype, Endian};
-
-/// How to read a headerless file, from the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RawLayout {
-    /// `[nx, ny, nz]`, x fastest.
-    pub dims: [usize; 3],
-    /// Sample type.
-    pub dtype: Dtype,
-    /// Byte order.
-    pub endian: Endian,
-    /// Bytes to skip before the samples.
-    pub header_bytes: u64,
-}
 
 /// Reader options from the command line that only some formats accept.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

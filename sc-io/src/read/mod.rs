@@ -25,7 +25,8 @@ mod zarr;
 
 use std::path::Path;
 
-pub use format::{Format, RawLayout, ReadOptions};
+pub use format::{Format, ReadOptions};
+pub use raw::RawLayout;
 
 use crate::error::{Error, Result};
 use crate::progress::Progress;
