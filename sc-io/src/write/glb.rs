@@ -8,7 +8,8 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
-use super::{WriteOptions, le_words};
+use super::binary::le_words;
+use super::options::WriteOptions;
 use crate::space::Space;
 use serde_json::{Value, json};
 

@@ -4,7 +4,7 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
-use super::WriteOptions;
+use super::options::WriteOptions;
 use super::text::Lines;
 
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.

@@ -4,8 +4,9 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
+use super::binary::{in_chunks, le_words};
+use super::options::WriteOptions;
 use super::text::Lines;
-use super::{WriteOptions, in_chunks, le_words};
 
 fn header(
     mesh: &Mesh,

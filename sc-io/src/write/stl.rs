@@ -4,7 +4,7 @@ use std::io::{self, Write};
 
 use sc_runtime::Mesh;
 
-use super::in_chunks;
+use super::binary::in_chunks;
 
 /// Writes the 80-byte header, the triangle count and one 50-byte record per triangle.
 pub fn write(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
