@@ -230,7 +230,11 @@ pub struct ExtractArgs {
     pub block: Option<u32>,
     /// Which steps run: `embedded` merges only where the result stays a closed 2-manifold,
     /// `paper` merges every interior grey edge as the paper does, `steps123` does not merge.
-    #[arg(long, value_parser = named::<Mode>(Mode::ALL.map(|m| (m.name(), mode_help(m)))), default_value_t = Mode::Embedded)]
+    #[arg(
+        long,
+        value_parser = named::<Mode>(Mode::ALL.map(|m| (m.name(), mode_help(m)))),
+        default_value_t = Mode::Embedded
+    )]
     pub mode: Mode,
     /// Merge a grey edge only if the vertex it removes lies closer than this to the two
     /// triangles that replace its four, and their new diagonal closer than this to the four: a
