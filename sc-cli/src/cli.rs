@@ -2,9 +2,11 @@
 //! status 2 before any file is read.
 
 use std::path::PathBuf;
+use std::str::FromStr;
 
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use sc_runtime::{ErrorBound, Mode};
+use sc_runtime::{ErrorBound, ErrorUnits, Mode, UnknownName};
 
 use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
@@ -228,8 +230,12 @@ pub struct ExtractArgs {
     pub block: Option<u32>,
     /// Which steps run: `embedded` merges only where the result stays a closed 2-manifold,
     /// `paper` merges every interior grey edge as the paper does, `steps123` does not merge.
-    #[arg(long, value_enum, default_value_t = ModeArg::Embedded)]
-    pub mode: ModeArg,
+    #[arg(
+        long,
+        value_parser = named::<Mode>(Mode::ALL.map(|m| (m.name(), mode_help(m)))),
+        default_value_t = Mode::Embedded
+    )]
+    pub mode: Mode,
     /// Merge a grey edge only if the vertex it removes lies closer than this to the two
     /// triangles that replace its four, and their new diagonal closer than this to the four: a
     /// bound on how far Step 4 moves the surface, in the volume's world units (mm for most
@@ -239,7 +245,12 @@ pub struct ExtractArgs {
     #[arg(long, value_parser = parse_max_error)]
     pub max_error: Option<f64>,
     /// The units of `--max-error`.
-    #[arg(long, value_enum, default_value_t = ErrorUnits::World, requires = "max_error")]
+    #[arg(
+        long,
+        value_parser = named::<ErrorUnits>(ErrorUnits::ALL.map(|u| (u.name(), units_help(u)))),
+        default_value_t = ErrorUnits::World,
+        requires = "max_error"
+    )]
     pub error_units: ErrorUnits,
     /// Leave out per-vertex normals.
     #[arg(long)]
@@ -348,43 +359,42 @@ pub enum Demo {
     SphereNoise,
 }
 
-/// `--mode` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ModeArg {
-    /// Steps 1–4, merging where the surface stays a closed 2-manifold.
-    Embedded,
-    /// Steps 1–4, merging every interior grey edge, as the paper does.
-    Paper,
-    /// Steps 1–3 only: no merging.
-    Steps123,
+/// A parser for names from one of the runtime's tables ([`Mode::NAMES`], [`ErrorUnits::NAMES`]),
+/// each shown in `--help` with its line of help, so that the command line spells them as every
+/// other front end does.
+fn named<T>(
+    values: impl IntoIterator<Item = (&'static str, &'static str)>,
+) -> impl TypedValueParser<Value = T>
+where
+    T: FromStr<Err = UnknownName> + Clone + Send + Sync + 'static,
+{
+    let values = values
+        .into_iter()
+        .map(|(name, help)| PossibleValue::new(name).help(help));
+    PossibleValuesParser::new(values).try_map(|name| name.parse::<T>())
 }
 
-impl From<ModeArg> for Mode {
-    fn from(m: ModeArg) -> Mode {
-        match m {
-            ModeArg::Embedded => Mode::Embedded,
-            ModeArg::Paper => Mode::Paper,
-            ModeArg::Steps123 => Mode::Steps123,
-        }
+/// `--mode`'s help for each value.
+fn mode_help(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Embedded => "Steps 1–4, merging where the surface stays a closed 2-manifold",
+        Mode::Paper => "Steps 1–4, merging every interior grey edge, as the paper does",
+        Mode::Steps123 => "Steps 1–3 only: no merging",
     }
 }
 
-/// `--error-units` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ErrorUnits {
-    /// The volume's world units: spacing × index, usually mm.
-    World,
-    /// Grid steps, whatever the spacing.
-    Voxels,
+/// `--error-units`' help for each value.
+fn units_help(units: ErrorUnits) -> &'static str {
+    match units {
+        ErrorUnits::World => "The volume's world units: spacing × index, usually mm",
+        ErrorUnits::Voxels => "Grid steps, whatever the spacing",
+    }
 }
 
 impl ExtractArgs {
     /// The bound `--max-error` and `--error-units` ask for.
     pub fn error_bound(&self) -> Option<ErrorBound> {
-        self.max_error.map(|d| match self.error_units {
-            ErrorUnits::World => ErrorBound::World(d),
-            ErrorUnits::Voxels => ErrorBound::Voxels(d),
-        })
+        self.max_error.map(|d| ErrorBound::new(d, self.error_units))
     }
 }
 

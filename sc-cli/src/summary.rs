@@ -3,6 +3,7 @@
 use std::fmt;
 use std::time::Duration;
 
+use sc_io::report;
 use sc_runtime::{ErrorBound, Mode, Stats};
 use serde_json::{Value, json};
 
@@ -68,33 +69,12 @@ pub fn thousands(n: u64) -> String {
     out
 }
 
-/// Triangles saved against Steps 1–3, in percent.
-pub fn reduction(stats: &Stats) -> f64 {
-    if stats.t13 == 0 {
-        0.0
-    } else {
-        100.0 * (1.0 - stats.triangles as f64 / stats.t13 as f64)
-    }
-}
-
 /// Adds the mode, the bound and the counts to the JSON object `j`, under the names `extract
-/// --stats-json` uses, so that `merge --stats-json` reports them the same way.
+/// --stats-json` uses (see [`sc_io::report::counts`]), so that `merge --stats-json` reports
+/// them the same way.
 pub fn add_counts(j: &mut Value, mode: Mode, max_error: Option<ErrorBound>, s: &Stats) {
-    let counts = json!({
-        "mode": format!("{mode:?}").to_lowercase(),
-        "steps123": { "vertices": s.v13, "triangles": s.t13 },
-        "result": { "vertices": s.vertices, "triangles": s.triangles },
-        "merged": s.merged,
-        "blocked": s.blocked,
-        "bounded": s.bounded,
-        "max_error": max_error.map(|b| match b {
-            ErrorBound::World(d) => json!({ "value": d, "units": "world" }),
-            ErrorBound::Voxels(d) => json!({ "value": d, "units": "voxels" }),
-        }),
-        "reduction_percent": reduction(s),
-    });
-    if let (Value::Object(j), Value::Object(counts)) = (j, counts) {
-        j.extend(counts);
+    if let Value::Object(j) = j {
+        j.extend(report::counts(mode, max_error, s));
     }
 }
 
@@ -158,7 +138,7 @@ impl fmt::Display for Summary {
                 mode_name(self.mode),
                 thousands(s.vertices),
                 thousands(s.triangles),
-                reduction(s),
+                s.reduction_percent(),
                 thousands(s.merged)
             )?;
         }

@@ -22,13 +22,28 @@
 //! The `zarr` feature (on by default) reads Zarr arrays and OME-Zarr images through `zarrs` and
 //! the C libraries of its codecs; without it a Zarr store is refused with a message that says
 //! so, and the build is shorter (the fuzzer has no Zarr target and leaves it off).
+//!
+//! The public modules, a front end's whole view of the crate:
+//!
+//! - [`read`]: a volume file in, as a [`volume::Grid`] ([`read::stream`] for slab-by-slab
+//!   reading); [`volume`]: the grid and its typed samples; [`space`]: where it sits in the
+//!   scanner's world.
+//! - [`surface`]: the extraction of a grid (whole, streamed, or as [`shard`]s).
+//! - [`write`](mod@write): a mesh out, in the format its file name asks for, through an
+//!   [`atomic`] file, whole or not at all; [`mesh_in`]: a mesh read back, for comparisons.
+//! - [`report`]: the counts of an extraction as JSON; [`progress`]: how long-running work
+//!   tells how far it got.
+//!
+//! The formats' parsers and writers behind these are private: a format is chosen by its file
+//! name, never named by a caller.
 
 pub mod atomic;
-pub mod buffer;
-pub mod error;
+mod buffer;
+mod error;
 pub mod mesh_in;
 pub mod progress;
 pub mod read;
+pub mod report;
 pub mod shard;
 pub mod space;
 #[cfg(feature = "surface")]
@@ -37,3 +52,4 @@ pub mod volume;
 pub mod write;
 
 pub use error::{Error, Result};
+pub(crate) use volume::with_dtype;

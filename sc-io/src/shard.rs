@@ -34,14 +34,15 @@ use serde_json::{Value, json};
 
 use crate::atomic::AtomicFile;
 use crate::error::{Error, Result};
+use crate::report;
 use crate::space::{Space, World};
 
 /// The `format` field of a manifest.
-pub const MANIFEST_FORMAT: &str = "skelclimb-shards";
+const MANIFEST_FORMAT: &str = "skelclimb-shards";
 /// The `format` field of a shard's header.
-pub const SHARD_FORMAT: &str = "skelclimb-shard";
+const SHARD_FORMAT: &str = "skelclimb-shard";
 /// The version of both; a reader refuses others rather than guess.
-pub const VERSION: u64 = 1;
+const VERSION: u64 = 1;
 /// The manifest's file name inside a shard directory.
 pub const MANIFEST_NAME: &str = "manifest.json";
 
@@ -91,46 +92,25 @@ impl Settings {
         }
     }
 
-    /// The mode's name as the command line and Python spell it.
-    pub fn mode_name(&self) -> &'static str {
-        match self.mode {
-            Mode::Embedded => "embedded",
-            Mode::Paper => "paper",
-            Mode::Steps123 => "steps123",
-        }
-    }
-
     fn to_json(self) -> Value {
         json!({
             "iso": self.iso,
-            "mode": self.mode_name(),
+            "mode": self.mode.name(),
             "normals": self.normals,
             "spacing": self.spacing,
             "origin": self.origin,
-            "max_error": self.max_error.map(|b| match b {
-                ErrorBound::World(d) => json!({ "value": d, "units": "world" }),
-                ErrorBound::Voxels(d) => json!({ "value": d, "units": "voxels" }),
-            }),
+            "max_error": self.max_error.map(report::bound),
         })
     }
 
     fn from_json(v: &Value) -> Option<Settings> {
-        let mode = match v["mode"].as_str()? {
-            "embedded" => Mode::Embedded,
-            "paper" => Mode::Paper,
-            "steps123" => Mode::Steps123,
-            _ => return None,
-        };
+        let mode = v["mode"].as_str()?.parse().ok()?;
         let max_error = match &v["max_error"] {
             Value::Null => None,
-            b => {
-                let d = b["value"].as_f64()?;
-                Some(match b["units"].as_str()? {
-                    "world" => ErrorBound::World(d),
-                    "voxels" => ErrorBound::Voxels(d),
-                    _ => return None,
-                })
-            }
+            b => Some(ErrorBound::new(
+                b["value"].as_f64()?,
+                b["units"].as_str()?.parse().ok()?,
+            )),
         };
         Some(Settings {
             iso: v["iso"].as_f64()?,
@@ -419,25 +399,23 @@ pub fn write_shard(path: &Path, block: &BlockMesh, settings: &Settings) -> Resul
     })
 }
 
-/// The seven counts by name, as the summaries spell them.
+/// The seven counts by name ([`Stats::NAMES`]).
 fn stats_json(s: &Stats) -> Value {
-    json!({
-        "v13": s.v13, "t13": s.t13, "merged": s.merged, "blocked": s.blocked,
-        "bounded": s.bounded, "vertices": s.vertices, "triangles": s.triangles,
-    })
+    Value::Object(
+        Stats::NAMES
+            .iter()
+            .zip(s.to_array())
+            .map(|(name, n)| (name.to_string(), n.into()))
+            .collect(),
+    )
 }
 
 fn stats_from_json(v: &Value) -> Option<Stats> {
-    let n = |k: &str| v[k].as_u64();
-    Some(Stats {
-        v13: n("v13")?,
-        t13: n("t13")?,
-        merged: n("merged")?,
-        blocked: n("blocked")?,
-        bounded: n("bounded")?,
-        vertices: n("vertices")?,
-        triangles: n("triangles")?,
-    })
+    let mut counts = [0; 7];
+    for (n, name) in counts.iter_mut().zip(Stats::NAMES) {
+        *n = v[name].as_u64()?;
+    }
+    Some(Stats::from_array(counts))
 }
 
 fn put<T, W>(npz: &mut NpzWriter<W>, name: &str, shape: &[usize], data: &[T]) -> io::Result<()>
@@ -610,7 +588,7 @@ fn read_checked(path: &Path, entry: &ShardEntry, manifest: &Manifest) -> Result<
 }
 
 /// Where the shard `entry` of the manifest at `manifest_path` is.
-pub fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
+fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
     manifest_path
         .parent()
         .unwrap_or(Path::new(""))

@@ -149,7 +149,6 @@ macro_rules! with_samples {
 }
 
 /// Runs `$body` with the type alias `$t` set to the Rust type of a [`Dtype`].
-#[macro_export]
 macro_rules! with_dtype {
     ($dtype:expr, $t:ident => $body:expr) => {
         match $dtype {
@@ -189,6 +188,8 @@ macro_rules! with_dtype {
     };
 }
 
+pub(crate) use with_dtype;
+
 impl Samples {
     /// The stored type.
     pub fn dtype(&self) -> Dtype {
@@ -216,7 +217,7 @@ fn dtype_of<T: Sample>(_: &[T]) -> Dtype {
 }
 
 /// What the readers and the padding need of a sample type beyond what the extractor needs.
-pub trait Sample: Scalar + Pod + PartialOrd + crate::read::zarr::Element {
+pub trait Sample: Scalar + Pod + PartialOrd {
     /// The matching [`Dtype`].
     const DTYPE: Dtype;
     /// Wraps typed samples.

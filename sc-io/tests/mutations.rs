@@ -143,7 +143,7 @@ fn mesh_seeds() -> &'static [(&'static str, Vec<u8>)] {
 }
 
 fn make_mesh_seeds() -> Vec<(&'static str, Vec<u8>)> {
-    use sc_io::write::{WriteOptions, obj, ply, stl};
+    use sc_io::write::{MeshFormat, WriteOptions};
     let grid = read(
         &fixture("brainsmall-crop-40x40x30.u8.raw"),
         &ReadOptions {
@@ -168,10 +168,14 @@ fn make_mesh_seeds() -> Vec<(&'static str, Vec<u8>)> {
         write(&mut bytes).unwrap();
         seeds.push((name, bytes));
     };
-    add("b.ply", &|out| ply::write_binary(&mesh, &options, out));
-    add("a.ply", &|out| ply::write_ascii(&mesh, &options, out));
-    add("m.obj", &|out| obj::write(&mesh, &options, out));
-    add("b.stl", &|out| stl::write(&mesh, out));
+    let ascii = WriteOptions {
+        ascii: true,
+        ..options
+    };
+    add("b.ply", &|out| MeshFormat::Ply.write(&mesh, &options, out));
+    add("a.ply", &|out| MeshFormat::Ply.write(&mesh, &ascii, out));
+    add("m.obj", &|out| MeshFormat::Obj.write(&mesh, &options, out));
+    add("b.stl", &|out| MeshFormat::Stl.write(&mesh, &options, out));
     let text: String = mesh
         .triangles
         .iter()

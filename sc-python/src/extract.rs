@@ -5,7 +5,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sc_io::space::{Space, World};
-use sc_runtime::{ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
+use sc_runtime::{ErrorBound, Figure, Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
 
 use crate::convert::{self, with_element};
 use crate::errors;
@@ -13,14 +13,8 @@ use crate::world;
 
 /// Parses a mode name as the CLI spells it.
 pub fn mode(name: &str) -> PyResult<Mode> {
-    match name {
-        "embedded" => Ok(Mode::Embedded),
-        "paper" => Ok(Mode::Paper),
-        "steps123" => Ok(Mode::Steps123),
-        _ => Err(PyValueError::new_err(format!(
-            "mode: expected 'embedded', 'paper' or 'steps123', got {name:?}"
-        ))),
-    }
+    name.parse()
+        .map_err(|e| PyValueError::new_err(format!("mode: {e}, got {name:?}")))
 }
 
 /// Parses `max_error` and `error_units` as `(value, units)`.
@@ -33,13 +27,10 @@ fn bound(bound: Option<(f64, String)>) -> PyResult<Option<ErrorBound>> {
             "max_error: must be a finite number, 0 or more, got {d}"
         )));
     }
-    match units.as_str() {
-        "world" => Ok(Some(ErrorBound::World(d))),
-        "voxels" => Ok(Some(ErrorBound::Voxels(d))),
-        _ => Err(PyValueError::new_err(format!(
-            "error_units: expected 'world' or 'voxels', got {units:?}"
-        ))),
-    }
+    let units = units
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("error_units: {e}, got {units:?}")))?;
+    Ok(Some(ErrorBound::new(d, units)))
 }
 
 /// Checks the numbers every front end takes and builds the runtime's parameters.
@@ -179,16 +170,15 @@ pub fn stats<'py>(
     d.set_item("iso", level)?;
     d.set_item("mode", mode)?;
     d.set_item("space", space.map(Space::name))?;
-    d.set_item("steps123", counts(s.v13, s.t13)?)?;
-    d.set_item("result", counts(s.vertices, s.triangles)?)?;
-    d.set_item("merged", s.merged)?;
-    d.set_item("blocked", s.blocked)?;
-    d.set_item("bounded", s.bounded)?;
-    let reduction = if s.t13 == 0 {
-        0.0
-    } else {
-        100.0 * (1.0 - s.triangles as f64 / s.t13 as f64)
-    };
-    d.set_item("reduction_percent", reduction)?;
+    for (name, figure) in s.report() {
+        match figure {
+            Figure::Mesh {
+                vertices,
+                triangles,
+            } => d.set_item(name, counts(vertices, triangles)?)?,
+            Figure::Edges(n) => d.set_item(name, n)?,
+        }
+    }
+    d.set_item("reduction_percent", s.reduction_percent())?;
     Ok(d)
 }

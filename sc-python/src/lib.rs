@@ -39,5 +39,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shards::merge_shards, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_class::<streamer::SliceStreamer>()?;
+    // The modes' names from the runtime's table, which every front end spells them by.
+    m.add("MODES", sc_runtime::Mode::NAMES)?;
     Ok(())
 }

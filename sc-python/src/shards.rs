@@ -89,7 +89,7 @@ pub fn merge_shards<'py>(py: Python<'py>, manifest: PathBuf) -> PyResult<Bound<'
     let stats = crate::extract::stats(
         py,
         &mesh.stats,
-        s.mode_name(),
+        s.mode.name(),
         s.iso,
         manifest.grid,
         manifest.world.space,

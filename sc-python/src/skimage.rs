@@ -6,10 +6,10 @@
 
 use numpy::{PyArray1, PyUntypedArray};
 use pyo3::prelude::*;
-use sc_runtime::{Axes, Mesh, Params};
+use sc_runtime::{Axes, Mesh, Mode, Params};
 
 use crate::convert::{self, with_element};
-use crate::extract::{mode, run};
+use crate::extract::run;
 
 /// Extracts the surface (embedded mode, with normals and values) and returns
 /// `(verts, faces, normals, values)`: with `reverse_axes`, coordinates as `(z, y, x)`; with
@@ -29,7 +29,7 @@ pub fn skimage_mesh<'py>(
     flip_winding: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
     let params = Params {
-        mode: mode("embedded")?,
+        mode: Mode::Embedded,
         normals: true,
         values: true,
         spacing,

@@ -17,11 +17,7 @@ use std::time::Duration;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use sc_runtime::{Extractor, Mode, Params, Scalar, Volume, demo, extract_par};
 
-const MODES: [(Mode, &str); 3] = [
-    (Mode::Steps123, "steps123"),
-    (Mode::Embedded, "embedded"),
-    (Mode::Paper, "paper"),
-];
+const MODES: [Mode; 3] = [Mode::Steps123, Mode::Embedded, Mode::Paper];
 
 fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usize; 3], iso: f64) {
     let vol = Volume::new(data, dims).expect("bench volumes are consistent");
@@ -34,7 +30,7 @@ fn bench_volume<T: Scalar>(c: &mut Criterion, name: &str, data: &[T], dims: [usi
     let threads = if all > 1 { vec![1, all] } else { vec![1] };
     let runs = MODES
         .iter()
-        .flat_map(|&(mode, name)| threads.iter().map(move |&t| (mode, name, false, t)))
+        .flat_map(|&mode| threads.iter().map(move |&t| (mode, mode.name(), false, t)))
         // Normals' cost, on one thread, in the mode people use.
         .chain([(Mode::Embedded, "embedded-normals", true, 1)]);
     for (mode, mode_name, normals, threads) in runs {

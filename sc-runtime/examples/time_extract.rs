@@ -43,12 +43,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map_or(Ok(1), |t| t.parse())?,
     };
     for mode in modes.split(',') {
-        let mode = match mode {
-            "steps123" => Mode::Steps123,
-            "embedded" => Mode::Embedded,
-            "paper" => Mode::Paper,
-            other => return Err(format!("unknown mode {other}").into()),
-        };
+        let mode: Mode = mode
+            .parse()
+            .map_err(|e| format!("unknown mode {mode}: {e}"))?;
         let Timing {
             median,
             fastest,

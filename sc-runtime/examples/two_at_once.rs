@@ -2,7 +2,8 @@
 //! independent ones at the same time, then `extract_par` on two threads.
 //!
 //! ```sh
-//! cargo run --release -p sc-runtime --example two_at_once -- ../shared/data/mni152-mri/mni152-mri.raw 197,233,189 80
+//! cargo run --release -p sc-runtime --example two_at_once -- \
+//!     tests/data/brainsmall-crop-40x40x30.u8.raw 40,40,30 20
 //! ```
 //! The volume is raw u8, x fastest.
 

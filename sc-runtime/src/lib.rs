@@ -23,11 +23,11 @@ mod drivers;
 mod kernel;
 
 pub use kernel::error::Error;
-pub use kernel::params::{Axes, ErrorBound, Mode, Params, Volume};
+pub use kernel::params::{Axes, ErrorBound, ErrorUnits, Mode, Params, UnknownName, Volume};
 pub use kernel::scalar::Scalar;
 pub use kernel::scratch::{Scratch, ScratchLen};
 pub use kernel::sink::Sink;
-pub use kernel::stats::Stats;
+pub use kernel::stats::{Figure, Stats};
 pub use kernel::{geometry, tables};
 
 pub use drivers::borrowed::extract_into;

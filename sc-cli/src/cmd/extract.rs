@@ -9,68 +9,29 @@ use sc_runtime::{Mesh, Mode};
 use super::warn;
 use crate::builtin;
 use crate::check::EdgeReport;
-use crate::cli::{Demo, ExtractArgs, ModeArg};
+use crate::cli::{Demo, ExtractArgs, Output};
 use crate::progress::{Bar, Counted};
 use crate::summary::Summary;
-use sc_io::atomic::AtomicFile;
-use sc_io::error::{Error, Result};
-use sc_io::progress::Progress;
-use sc_io::read::{self, Format, ReadOptions, stream};
+use sc_io::atomic::{AtomicFile, Filled};
+use sc_io::progress::{Progress, Silent};
+use sc_io::read::stream::{self, Stream};
+use sc_io::read::{self, Format, ReadOptions};
 use sc_io::surface::{self, Request};
 use sc_io::volume::Grid;
 use sc_io::write::{MeshFormat, WriteOptions};
-
-/// Whether the samples of `path` would take more than half the machine's memory, so that reading
-/// them slice by slice is the only sane way. Unknown sizes and memory (not Linux) say no.
-fn too_big(path: &Path, options: &ReadOptions) -> bool {
-    let Ok(Some(s)) = stream::open(path, options) else {
-        return false;
-    };
-    let bytes = s.grid.dims.iter().product::<usize>() as u64 * s.grid.samples.dtype().size() as u64;
-    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
-        let kib = m.lines().find(|l| l.starts_with("MemTotal:"))?;
-        kib.split_whitespace().nth(1)?.parse::<u64>().ok()
-    });
-    total.is_some_and(|kib| bytes > kib * 1024 / 2)
-}
+use sc_io::{Error, Result};
 
 /// Reads, extracts, writes and reports. Output files are opened first, so that a bad output
 /// path fails before a long read, and written whole or not at all.
 pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let options = args.read.read_options();
-    match (&args.input, args.demo) {
-        (Some(input), _) => {
-            Format::detect(input, &options)?;
-            if args.iso.is_none() {
-                return Err(Error::Usage(format!(
-                    "--iso is required for {}; `skelclimb info {}` suggests values",
-                    input.display(),
-                    input.display()
-                )));
-            }
-        }
-        (None, _) if options != read::ReadOptions::default() => {
-            return Err(Error::Usage("--dims, --dtype, --endian, --header-bytes and --array describe input files, not --demo".into()));
-        }
-        _ => {}
-    }
+    let format = check_input(args, &options)?;
     let output = match (&args.output, &args.shards) {
         (_, Some(dir)) => return shards(args, dir, &options, quiet),
         (Some(output), None) => output,
         (None, None) => return Err(Error::Usage("give -o FILE or --shards DIR".into())),
     };
-    // clap does not enforce `requires` beside `-o`'s conflict with --shards.
-    if args.block.is_some() {
-        return Err(Error::Usage("--block applies with --shards only".into()));
-    }
-    if args.ascii && output.format != MeshFormat::Ply {
-        return Err(Error::Usage("--ascii applies to .ply output only".into()));
-    }
-    check_outputs(
-        args.input.as_deref(),
-        &output.path,
-        args.stats_json.as_deref(),
-    )?;
+    check_output(args, output)?;
     let mesh_file = AtomicFile::create(&output.path)?;
     let stats_file = args
         .stats_json
@@ -80,93 +41,35 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
 
     let clock = Instant::now();
-    let mut stream = match &args.input {
-        Some(path)
-            if args.stream
-                || (!args.pad
-                    && (Format::detect(path, &options)? == Format::Zarr
-                        || too_big(path, &options))) =>
-        {
-            stream::open(path, &options)?
-        }
-        _ => None,
-    };
-    if let (true, None, Some(path)) = (args.stream, &stream, &args.input) {
-        return Err(Error::Usage(format!(
-            "{}: --stream reads raw files, NIfTI (.nii, .nii.gz) and Zarr slice by slice; this \
-             file is read whole",
-            path.display()
-        )));
-    }
-    let (mut grid, iso, input) = match (&stream, &args.input) {
-        (Some(s), Some(path)) => (
-            s.grid.clone(),
-            args.iso.unwrap_or_default(),
-            path.display().to_string(),
-        ),
-        _ => load(args, &options, &progress)?,
-    };
+    let (mut volume, iso, input) = open(args, format, &options, &progress)?;
     let read_time = clock.elapsed();
-    let file_dims = grid.dims;
-    args.placement.apply(&mut grid);
-    if args.pad {
-        grid.pad(iso).map_err(|e| Error::file(&input, e))?;
-    }
+    let file_dims = volume.grid().dims;
+    place(args, volume.grid_mut(), iso, &input)?;
 
     let clock = Instant::now();
     let request = request(args, iso);
-    let world = surface::world(&grid, &request);
-    let mesh = match &mut stream {
-        Some(s) => {
-            s.grid.spacing = grid.spacing;
-            s.grid.origin = grid.origin;
-            surface::extract_stream(s, &request, &progress)?
-        }
-        None => surface::extract(&grid, &request, &progress)?,
+    let world = surface::world(volume.grid(), &request);
+    let mesh = match &mut volume {
+        Volume::Whole(grid) => surface::extract(grid, &request, &progress)?,
+        Volume::Streamed(stream) => surface::extract_stream(stream, &request, &progress)?,
     };
     let extract_time = clock.elapsed();
-    // The value range is only needed to explain an empty mesh, so the pass over every sample
-    // is made only then (and not at all over a volume that was streamed).
     if mesh.triangles.is_empty() {
-        let why = (stream.is_none())
-            .then(|| surface::why_empty(&grid.range(), iso))
-            .flatten()
-            .unwrap_or_else(|| "no sample is on both sides of the iso value".into());
-        warn(format!("{input}: {why}; writing an empty mesh"));
+        warn(format!(
+            "{input}: {}; writing an empty mesh",
+            why_empty(&volume, iso)
+        ));
     }
-    let is_paper_knot =
-        args.demo == Some(Demo::Knot) && args.size == 64 && args.iso.is_none_or(|i| i == iso);
-    let paper_knot = match args.mode {
-        _ if !is_paper_knot => None,
-        ModeArg::Paper => Some(mesh.stats.triangles),
-        _ => {
-            // Table 1's figure, without any --max-error.
-            let request = Request {
-                mode: Mode::Paper,
-                normals: false,
-                max_error: None,
-                ..request
-            };
-            Some(
-                surface::extract(&grid, &request, &sc_io::progress::Silent)?
-                    .stats
-                    .triangles,
-            )
-        }
-    };
+    let paper_knot = paper_knot(args, &volume, &request, &mesh)?;
 
     let clock = Instant::now();
-    progress.phase("writing", approx_bytes(&mesh, output.format, args.ascii));
-    let mesh_filled = mesh_file.fill(|out| {
-        let mut counted = Counted::new(out, &progress);
-        let options = WriteOptions {
-            ascii: args.ascii,
-            space: world.space,
-        };
-        output.format.write(&mesh, &options, &mut counted)?;
-        counted.flush()
-    })?;
+    let write_options = WriteOptions {
+        ascii: args.ascii,
+        space: world.space,
+    };
+    let mesh_filled = write_mesh(mesh_file, &mesh, output.format, &write_options, &progress)?;
     progress.finish();
+    let grid = volume.grid();
     let summary = Summary {
         input,
         format: grid.format,
@@ -175,7 +78,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         coordinates: world.describe(),
         dtype: grid.samples.dtype().name(),
         iso,
-        mode: args.mode.into(),
+        mode: args.mode,
         max_error: args.error_bound(),
         stats: mesh.stats,
         read: read_time,
@@ -189,6 +92,193 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         println!("{summary}");
     }
     Ok(())
+}
+
+/// The input's format (none for `--demo`), once the arguments are known to fit it.
+fn check_input(args: &ExtractArgs, options: &ReadOptions) -> Result<Option<Format>> {
+    match &args.input {
+        Some(input) => {
+            let format = Format::detect(input, options)?;
+            if args.iso.is_none() {
+                return Err(Error::Usage(format!(
+                    "--iso is required for {}; `skelclimb info {}` suggests values",
+                    input.display(),
+                    input.display()
+                )));
+            }
+            Ok(Some(format))
+        }
+        None if *options != ReadOptions::default() => Err(Error::Usage(
+            "--dims, --dtype, --endian, --header-bytes and --array describe input files, not --demo"
+                .into(),
+        )),
+        None => Ok(None),
+    }
+}
+
+/// Refuses options that do not fit a single output file (clap does not enforce `requires`
+/// beside `-o`'s conflict with --shards), and outputs that would overwrite the input or each
+/// other.
+fn check_output(args: &ExtractArgs, output: &Output) -> Result<()> {
+    if args.block.is_some() {
+        return Err(Error::Usage("--block applies with --shards only".into()));
+    }
+    if args.ascii && output.format != MeshFormat::Ply {
+        return Err(Error::Usage("--ascii applies to .ply output only".into()));
+    }
+    check_outputs(
+        args.input.as_deref(),
+        &output.path,
+        args.stats_json.as_deref(),
+    )
+}
+
+/// The volume to mesh: in memory, or open to be read a slab at a time.
+enum Volume {
+    Whole(Grid),
+    /// The grid of a stream holds the placement and type, not the samples.
+    Streamed(Stream),
+}
+
+impl Volume {
+    fn grid(&self) -> &Grid {
+        match self {
+            Volume::Whole(grid) => grid,
+            Volume::Streamed(stream) => &stream.grid,
+        }
+    }
+
+    fn grid_mut(&mut self) -> &mut Grid {
+        match self {
+            Volume::Whole(grid) => grid,
+            Volume::Streamed(stream) => &mut stream.grid,
+        }
+    }
+}
+
+/// The volume, its iso value and its name for messages: streamed when [`open_stream`] says so,
+/// otherwise read whole (or built in).
+fn open(
+    args: &ExtractArgs,
+    format: Option<Format>,
+    options: &ReadOptions,
+    progress: &dyn Progress,
+) -> Result<(Volume, f64, String)> {
+    if let (Some(path), Some(format)) = (&args.input, format)
+        && let Some(stream) = open_stream(args, path, format, options)?
+    {
+        let iso = args.iso.unwrap_or_default();
+        return Ok((Volume::Streamed(stream), iso, path.display().to_string()));
+    }
+    let (grid, iso, input) = load(args, options, progress)?;
+    Ok((Volume::Whole(grid), iso, input))
+}
+
+/// The input opened for reading slab by slab, if it is to be read so: with --stream (refused for
+/// a format that is only read whole), and without --pad (which needs every sample at once) for
+/// a Zarr store or for samples that would fill more than half the machine's memory.
+fn open_stream(
+    args: &ExtractArgs,
+    path: &Path,
+    format: Format,
+    options: &ReadOptions,
+) -> Result<Option<Stream>> {
+    if args.stream {
+        return match stream::open(path, options)? {
+            Some(stream) => Ok(Some(stream)),
+            None => Err(Error::Usage(format!(
+                "{}: --stream reads raw files, NIfTI (.nii, .nii.gz) and Zarr slice by slice; \
+                 this file is read whole",
+                path.display()
+            ))),
+        };
+    }
+    if args.pad {
+        Ok(None)
+    } else if format == Format::Zarr {
+        stream::open(path, options)
+    } else {
+        // A header that does not open here is the whole read's to report, in its words.
+        Ok(stream::open(path, options).ok().flatten().filter(too_big))
+    }
+}
+
+/// Whether the samples of `stream` would take more than half the machine's memory, so that
+/// reading them slice by slice is the only sane way. Unknown memory (not Linux) says no.
+fn too_big(stream: &Stream) -> bool {
+    let grid = &stream.grid;
+    let bytes = grid.dims.iter().product::<usize>() as u64 * grid.samples.dtype().size() as u64;
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let kib = m.lines().find(|l| l.starts_with("MemTotal:"))?;
+        kib.split_whitespace().nth(1)?.parse::<u64>().ok()
+    });
+    total.is_some_and(|kib| bytes > kib * 1024 / 2)
+}
+
+/// Applies `--spacing`, `--origin` and `--pad` to `grid`.
+fn place(args: &ExtractArgs, grid: &mut Grid, iso: f64, input: &str) -> Result<()> {
+    args.placement.apply(grid);
+    if args.pad {
+        grid.pad(iso).map_err(|e| Error::file(input, e))?;
+    }
+    Ok(())
+}
+
+/// Why the mesh is empty, in words. The value range is only needed for this, so the pass over
+/// every sample is made only then, and not at all over a volume that was streamed.
+fn why_empty(volume: &Volume, iso: f64) -> String {
+    match volume {
+        Volume::Whole(grid) => surface::why_empty(&grid.range(), iso),
+        Volume::Streamed(_) => None,
+    }
+    .unwrap_or_else(|| "no sample is on both sides of the iso value".into())
+}
+
+/// For the paper's knot at the paper's size and iso: the triangles of paper mode, printed beside
+/// Table 1's figures (meshed again, in paper mode and without any --max-error, if the run was in
+/// another mode).
+fn paper_knot(
+    args: &ExtractArgs,
+    volume: &Volume,
+    request: &Request,
+    mesh: &Mesh,
+) -> Result<Option<u64>> {
+    let is_paper_knot = args.demo == Some(Demo::Knot)
+        && args.size == 64
+        && args.iso.is_none_or(|i| i == request.iso);
+    match volume {
+        _ if !is_paper_knot => Ok(None),
+        _ if args.mode == Mode::Paper => Ok(Some(mesh.stats.triangles)),
+        Volume::Whole(grid) => {
+            let request = Request {
+                mode: Mode::Paper,
+                normals: false,
+                max_error: None,
+                ..*request
+            };
+            Ok(Some(
+                surface::extract(grid, &request, &Silent)?.stats.triangles,
+            ))
+        }
+        // A built-in volume is never streamed.
+        Volume::Streamed(_) => Ok(None),
+    }
+}
+
+/// Writes `mesh` into `file`, counting the bytes for the progress bar.
+fn write_mesh(
+    file: AtomicFile,
+    mesh: &Mesh,
+    format: MeshFormat,
+    options: &WriteOptions,
+    progress: &dyn Progress,
+) -> Result<Filled> {
+    progress.phase("writing", approx_bytes(mesh, format, options.ascii));
+    file.fill(|out| {
+        let mut counted = Counted::new(out, progress);
+        format.write(mesh, options, &mut counted)?;
+        counted.flush()
+    })
 }
 
 /// The volume read whole (or built in), its iso value, and its name for messages.
@@ -219,7 +309,7 @@ fn load(
 fn request(args: &ExtractArgs, iso: f64) -> Request {
     Request {
         iso,
-        mode: args.mode.into(),
+        mode: args.mode,
         normals: !args.no_normals,
         threads: args.threads,
         coordinates: args.space,
@@ -231,10 +321,7 @@ fn request(args: &ExtractArgs, iso: f64) -> Request {
 fn shards(args: &ExtractArgs, dir: &Path, options: &ReadOptions, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
     let (mut grid, iso, input) = load(args, options, &progress)?;
-    args.placement.apply(&mut grid);
-    if args.pad {
-        grid.pad(iso).map_err(|e| Error::file(&input, e))?;
-    }
+    place(args, &mut grid, iso, &input)?;
     let block = args.block.unwrap_or(128) as usize;
     let manifest = surface::extract_shards(&grid, &request(args, iso), block, dir, &progress)?;
     progress.finish();

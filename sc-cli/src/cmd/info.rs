@@ -6,7 +6,7 @@ use crate::cli::InfoArgs;
 use crate::histogram::Histogram;
 use crate::progress::Bar;
 use crate::summary::thousands;
-use sc_io::error::Result;
+use sc_io::Result;
 use sc_io::read;
 use sc_io::read::dicom::{self, SeriesInfo};
 use sc_io::volume::{Dtype, Grid, Range};

@@ -7,9 +7,9 @@ use serde_json::json;
 use crate::cli::MergeArgs;
 use crate::summary::{self, mode_name, thousands};
 use sc_io::atomic::AtomicFile;
-use sc_io::error::{Error, Result};
 use sc_io::shard;
 use sc_io::write::{MeshFormat, WriteOptions};
+use sc_io::{Error, Result};
 
 /// Joins the shards the manifest lists and writes the mesh (and the counts), whole or not at all.
 pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {

@@ -9,10 +9,10 @@ use crate::cli::{Demo, Table1Args, split_iso};
 use crate::histogram::Histogram;
 use crate::progress::Bar;
 use crate::summary::{PAPER_KNOT, thousands};
-use sc_io::error::{Error, Result};
 use sc_io::read;
 use sc_io::surface::{self, Request};
 use sc_io::volume::Grid;
+use sc_io::{Error, Result};
 
 const MODES: [Mode; 3] = [Mode::Steps123, Mode::Embedded, Mode::Paper];
 

@@ -9,8 +9,8 @@ mod font;
 use std::path::Path;
 
 use sc_io::atomic::AtomicFile;
-use sc_io::error::{Error, Result};
 use sc_io::mesh_in::{self, TriangleMesh};
+use sc_io::{Error, Result};
 
 use crate::cli::{RenderArgs, View};
 

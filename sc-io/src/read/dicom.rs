@@ -158,7 +158,7 @@ fn choose(dir: &Path, mut groups: Vec<Vec<Slice>>, wanted: Option<&str>) -> Resu
 }
 
 /// Reads the series in `dir` (or below it).
-pub fn read(dir: &Path, choice: &DicomOptions, progress: &dyn Progress) -> Result<Grid> {
+pub(crate) fn read(dir: &Path, choice: &DicomOptions, progress: &dyn Progress) -> Result<Grid> {
     let mut slices = choose(dir, group(headers(dir)?), choice.series.as_deref())?;
     let Some(first) = slices.first() else {
         return Err(Error::file(dir, "no DICOM files in this directory"));

@@ -5,9 +5,9 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
+use super::block::{Block, Start, read_block};
 use super::header::{Syntax, TextHeader};
 use super::payload::{self, Encoding, Layout};
-use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::space::{Frame, Space};

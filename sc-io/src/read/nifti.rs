@@ -8,8 +8,8 @@ use std::path::Path;
 
 use nifti::{Endianness, NiftiHeader, NiftiType};
 
+use super::block::{Block, Start, read_block};
 use super::payload::{Encoding, Layout};
-use super::{Block, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::space::{Frame, Space};

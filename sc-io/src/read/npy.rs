@@ -14,7 +14,7 @@ use npyz::npz::NpzArchive;
 use npyz::{DType, NpyHeader, Order, TypeChar};
 use py_literal::Value;
 
-use super::MAX_TRAILING;
+use super::block::MAX_TRAILING;
 use super::payload::{self, Layout};
 use crate::error::{Error, Result};
 use crate::progress::Progress;

@@ -2,11 +2,24 @@
 
 use std::path::Path;
 
+use super::block::{Block, Start, read_block};
 use super::payload::{Encoding, Layout};
-use super::{Block, RawLayout, Start, read_block};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
-use crate::volume::Grid;
+use crate::volume::{Dtype, Endian, Grid};
+
+/// How to read a headerless file, from the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RawLayout {
+    /// `[nx, ny, nz]`, x fastest.
+    pub dims: [usize; 3],
+    /// Sample type.
+    pub dtype: Dtype,
+    /// Byte order.
+    pub endian: Endian,
+    /// Bytes to skip before the samples.
+    pub header_bytes: u64,
+}
 
 /// Reads `path` as `layout` says. The file size must match exactly: a raw file has nothing else
 /// to catch wrong `--dims` or `--dtype`, and a size mismatch is almost always one.

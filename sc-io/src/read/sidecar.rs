@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use super::RawLayout;
+use super::raw::RawLayout;
 use crate::error::{Error, Result};
 use crate::volume::{Dtype, Endian};
 

@@ -6,8 +6,11 @@
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
+use super::block::{Block, MAX_TRAILING, Start, block_error, open_block};
+use super::format::{Format, ReadOptions};
 use super::payload::{self, Encoding, Layout};
-use super::{Block, Format, ReadOptions, block_error, nifti, open_block, raw, sidecar, zarr};
+use super::placement::check_placement;
+use super::{nifti, raw, sidecar, zarr};
 use crate::error::{Error, Result};
 use crate::progress::{Progress, Silent};
 use crate::volume::{Grid, Sample, Samples};
@@ -69,7 +72,7 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
         }
         Format::Zarr => {
             let (grid, source) = zarr::open(path, options.zarr_level)?;
-            super::check_placement(path, &grid)?;
+            check_placement(path, &grid)?;
             return Ok(Some(Stream {
                 grid,
                 path: path.to_path_buf(),
@@ -80,7 +83,7 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
         _ => return Ok(None),
     };
     grid.format = format.name();
-    super::check_placement(path, &grid)?;
+    check_placement(path, &grid)?;
     Ok(Some(Stream {
         source: Source::Block {
             reader: open_block(&block)?,
@@ -99,7 +102,7 @@ const SLAB_BYTES: usize = 16 << 20;
 
 impl Stream {
     /// z-slices per read that suit the source: a row of chunks for Zarr, about 16 MiB for files.
-    pub fn slab(&self) -> usize {
+    pub(crate) fn slab(&self) -> usize {
         match &self.source {
             Source::Zarr(z) => z.chunk_z().max(1),
             Source::Block { layout, .. } => {
@@ -110,7 +113,7 @@ impl Stream {
     }
 
     /// The next `slices` z-slices (fewer at the end), x fastest.
-    pub fn read<T: Sample>(&mut self, slices: usize) -> Result<Vec<T>> {
+    pub(crate) fn read<T: Sample>(&mut self, slices: usize) -> Result<Vec<T>> {
         let [nx, ny, nz] = self.grid.dims;
         let slices = slices.min(nz - self.read);
         let (z0, z1) = (self.read, self.read + slices);
@@ -131,8 +134,7 @@ impl Stream {
                     payload::read_typed::<T>(&mut *reader, slab, false, &Silent).map_err(error)?;
                 if z1 == nz && *encoding != Encoding::Raw {
                     // As a whole read does: read on to make the decoder check the gzip CRC.
-                    io::copy(&mut reader.take(super::MAX_TRAILING), &mut io::sink())
-                        .map_err(error)?;
+                    io::copy(&mut reader.take(MAX_TRAILING), &mut io::sink()).map_err(error)?;
                 }
                 samples
             }
@@ -142,7 +144,7 @@ impl Stream {
     }
 
     /// Every sample, for a whole read.
-    pub fn read_all(mut self, progress: &dyn Progress) -> Result<Grid> {
+    pub(crate) fn read_all(mut self, progress: &dyn Progress) -> Result<Grid> {
         let dtype = self.grid.samples.dtype();
         progress.phase("reading", self.grid.dims[2] as u64);
         let samples = crate::with_dtype!(dtype, T => {
@@ -164,7 +166,7 @@ impl Stream {
 fn block_at(path: &Path, encoding: Encoding, layout: Layout) -> Block<'_> {
     Block {
         path,
-        start: super::Start::At(0),
+        start: Start::At(0),
         skip_lines: 0,
         encoding,
         skip_decoded: 0,

@@ -14,11 +14,6 @@ use zarrs::group::Group;
 use crate::error::{Error, Result};
 use crate::volume::{Dtype, Grid, Sample, Samples};
 
-/// What a sample type needs to be read from a Zarr array: `zarrs`' element conversion.
-pub trait Element: zarrs::array::ElementOwned {}
-
-impl<T: zarrs::array::ElementOwned> Element for T {}
-
 /// An open Zarr array, read a slab of z-slices at a time.
 pub struct Source {
     array: Array<FilesystemStore>,
@@ -26,6 +21,8 @@ pub struct Source {
     lead: usize,
     /// z-slices per chunk: slabs of whole chunk rows decode each chunk once.
     chunk_z: usize,
+    /// The array's sample type.
+    dtype: Dtype,
 }
 
 /// Opens the array at `path` (or multiscale level `level` of an OME-Zarr image there): the grid
@@ -141,6 +138,7 @@ pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
             array,
             lead: n - 3,
             chunk_z,
+            dtype,
         },
     ))
 }
@@ -151,14 +149,30 @@ impl Source {
         self.chunk_z
     }
 
-    /// z-slices `z0..z1`, x fastest.
+    /// z-slices `z0..z1`, x fastest, of the array's sample type `T`. `zarrs` decodes to this
+    /// machine's byte order, so its bytes are the samples; they are copied, since a byte buffer
+    /// need not be aligned for `T`. (Read as bytes, a sample type needs no `zarrs` trait, and
+    /// [`Sample`] does not depend on this reader.)
     pub fn read<T: Sample>(&self, path: &Path, z0: usize, z1: usize) -> Result<Vec<T>> {
+        let error =
+            |e: &dyn std::fmt::Display| Error::file(path, format!("reading z {z0}..{z1}: {e}"));
+        if T::DTYPE != self.dtype {
+            return Err(error(&format_args!(
+                "the array holds {}, not {}",
+                self.dtype.name(),
+                T::DTYPE.name()
+            )));
+        }
         let shape = self.array.shape();
         let n = shape.len();
         let mut ranges = vec![0..1; self.lead];
         ranges.extend([z0 as u64..z1 as u64, 0..shape[n - 2], 0..shape[n - 1]]);
-        self.array
-            .retrieve_array_subset_elements::<T>(&ArraySubset::new_with_ranges(&ranges))
-            .map_err(|e| Error::file(path, format!("reading z {z0}..{z1}: {e}")))
+        let bytes = self
+            .array
+            .retrieve_array_subset(&ArraySubset::new_with_ranges(&ranges))
+            .map_err(|e| error(&e))?
+            .into_fixed()
+            .map_err(|e| error(&e))?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 }

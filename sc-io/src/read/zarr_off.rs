@@ -7,11 +7,6 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::volume::{Grid, Sample};
 
-/// Every sample type: nothing is read from Zarr.
-pub trait Element {}
-
-impl<T> Element for T {}
-
 /// No Zarr array opens in this build, so there is no source.
 pub enum Source {}
 

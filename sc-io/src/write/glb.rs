@@ -6,7 +6,9 @@
 
 use std::io::{self, Write};
 
-use super::{MeshSlices, WriteOptions, le_words};
+use super::binary::le_words;
+use super::options::WriteOptions;
+use super::slices::MeshSlices;
 use crate::space::Space;
 use serde_json::{Value, json};
 

@@ -2,8 +2,9 @@
 
 use std::io::{self, Write};
 
+use super::options::WriteOptions;
+use super::slices::MeshSlices;
 use super::text::Lines;
-use super::{MeshSlices, WriteOptions};
 
 /// Writes `v`, `vn` (if the mesh has normals) and `f` lines.
 pub fn write<'a>(

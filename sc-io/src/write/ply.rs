@@ -2,8 +2,10 @@
 
 use std::io::{self, Write};
 
+use super::binary::{in_chunks, le_words};
+use super::options::WriteOptions;
+use super::slices::MeshSlices;
 use super::text::Lines;
-use super::{MeshSlices, WriteOptions, in_chunks, le_words};
 
 fn header(
     mesh: MeshSlices<'_>,

@@ -2,7 +2,8 @@
 
 use std::io::{self, Write};
 
-use super::{MeshSlices, in_chunks};
+use super::binary::in_chunks;
+use super::slices::MeshSlices;
 
 /// Writes the 80-byte header, the triangle count and one 50-byte record per triangle.
 pub fn write<'a>(mesh: impl Into<MeshSlices<'a>>, out: &mut impl Write) -> io::Result<()> {

@@ -39,7 +39,7 @@ __all__ = [
     "release_memory",
 ]
 
-_MODES = ("embedded", "paper", "steps123")
+_MODES = tuple(_native.MODES)
 
 
 class Mesh:

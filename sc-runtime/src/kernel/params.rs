@@ -1,5 +1,31 @@
 use crate::{Error, Scalar};
 
+/// `Display` and `FromStr` for a type with a table of names, `NAMES`, in the order of `ALL`:
+/// each value is written as its name, and parsed from exactly that name.
+macro_rules! named {
+    ($t:ident) => {
+        impl core::fmt::Display for $t {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl core::str::FromStr for $t {
+            type Err = UnknownName;
+
+            fn from_str(name: &str) -> Result<$t, UnknownName> {
+                $t::NAMES
+                    .iter()
+                    .position(|n| *n == name)
+                    .map(|i| $t::ALL[i])
+                    .ok_or(UnknownName {
+                        expected: &$t::NAMES,
+                    })
+            }
+        }
+    };
+}
+
 /// Which steps of Skeleton Climbing run (SPEC §5).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Mode {
@@ -11,6 +37,55 @@ pub enum Mode {
     /// Steps 1–3 only: the Marching-Cubes-sized surface, no merging.
     Steps123,
 }
+
+impl Mode {
+    /// Every mode, in declaration order.
+    pub const ALL: [Mode; 3] = [Mode::Embedded, Mode::Paper, Mode::Steps123];
+
+    /// The modes' names, in the order of [`Mode::ALL`]: the one spelling that the command
+    /// line, Python, shard manifests and reports share.
+    pub const NAMES: [&'static str; 3] = ["embedded", "paper", "steps123"];
+
+    /// This mode's name (see [`Mode::NAMES`]).
+    pub const fn name(self) -> &'static str {
+        Mode::NAMES[self as usize]
+    }
+}
+
+named!(Mode);
+
+/// A name missing from a table of names ([`Mode::NAMES`], [`ErrorUnits::NAMES`]); its message
+/// lists the names that are valid, for a front end to put beside the name it was given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnknownName {
+    expected: &'static [&'static str],
+}
+
+impl UnknownName {
+    /// The valid names.
+    pub fn expected(&self) -> &'static [&'static str] {
+        self.expected
+    }
+}
+
+/// "expected 'a', 'b' or 'c'".
+impl core::fmt::Display for UnknownName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("expected ")?;
+        let last = self.expected.len().saturating_sub(1);
+        for (i, name) in self.expected.iter().enumerate() {
+            let sep = match i {
+                0 => "",
+                _ if i == last => " or ",
+                _ => ", ",
+            };
+            write!(f, "{sep}'{name}'")?;
+        }
+        Ok(())
+    }
+}
+
+impl core::error::Error for UnknownName {}
 
 /// The order of the coordinates of each position and normal a sweep emits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -34,6 +109,57 @@ pub enum ErrorBound {
     /// In grid steps: distances measured on sample indices, whatever the spacing.
     Voxels(f64),
 }
+
+impl ErrorBound {
+    /// A bound of `value` in `units`.
+    pub fn new(value: f64, units: ErrorUnits) -> ErrorBound {
+        match units {
+            ErrorUnits::World => ErrorBound::World(value),
+            ErrorUnits::Voxels => ErrorBound::Voxels(value),
+        }
+    }
+
+    /// The bound's number, in its units.
+    pub fn value(self) -> f64 {
+        match self {
+            ErrorBound::World(d) | ErrorBound::Voxels(d) => d,
+        }
+    }
+
+    /// The units the bound is in.
+    pub fn units(self) -> ErrorUnits {
+        match self {
+            ErrorBound::World(_) => ErrorUnits::World,
+            ErrorBound::Voxels(_) => ErrorUnits::Voxels,
+        }
+    }
+}
+
+/// The units of an [`ErrorBound`], without its number: what a front end parses from a name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ErrorUnits {
+    /// World units (see [`ErrorBound::World`]).
+    #[default]
+    World,
+    /// Grid steps (see [`ErrorBound::Voxels`]).
+    Voxels,
+}
+
+impl ErrorUnits {
+    /// Both units, in declaration order.
+    pub const ALL: [ErrorUnits; 2] = [ErrorUnits::World, ErrorUnits::Voxels];
+
+    /// The units' names, in the order of [`ErrorUnits::ALL`], as the command line, Python,
+    /// shard manifests and reports spell them.
+    pub const NAMES: [&'static str; 2] = ["world", "voxels"];
+
+    /// These units' name (see [`ErrorUnits::NAMES`]).
+    pub const fn name(self) -> &'static str {
+        ErrorUnits::NAMES[self as usize]
+    }
+}
+
+named!(ErrorUnits);
 
 /// Everything about an extraction besides the samples.
 #[derive(Clone, Copy, Debug)]
@@ -114,5 +240,31 @@ impl<'a, T: Scalar> Volume<'a, T> {
     /// `[nx, ny, nz]`.
     pub fn dims(&self) -> [usize; 3] {
         self.dims
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::string::ToString;
+
+    #[test]
+    fn names_round_trip_and_unknown_names_list_the_valid_ones() {
+        for (i, mode) in Mode::ALL.into_iter().enumerate() {
+            assert_eq!(mode.name(), Mode::NAMES[i]);
+            assert_eq!(mode.to_string(), Mode::NAMES[i]);
+            assert_eq!(mode.name().parse(), Ok(mode));
+        }
+        for (i, units) in ErrorUnits::ALL.into_iter().enumerate() {
+            assert_eq!(units.name(), ErrorUnits::NAMES[i]);
+            assert_eq!(units.name().parse(), Ok(units));
+            let bound = ErrorBound::new(0.5, units);
+            assert_eq!((bound.value(), bound.units()), (0.5, units));
+        }
+        let e = "Paper".parse::<Mode>().unwrap_err();
+        assert_eq!(e.expected(), &Mode::NAMES[..]);
+        assert_eq!(e.to_string(), "expected 'embedded', 'paper' or 'steps123'");
+        let e = "mm".parse::<ErrorUnits>().unwrap_err();
+        assert_eq!(e.to_string(), "expected 'world' or 'voxels'");
     }
 }
