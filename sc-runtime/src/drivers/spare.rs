@@ -1,12 +1,10 @@
 //! Scratch buffers kept between extractions, up to a budget.
 //!
 //! A sweep needs about 13 bytes per sample of a slice (1.8 MB for 256 × 256). Allocated afresh
-//! for every extraction and freed with it, that scratch is what tipped glibc's `malloc` into
-//! returning the heap's top to the kernel after each call, so that the next call faulted every
-//! page of its mesh in again: on a 256 × 256 × 20 MRI, two threads' two scratches made 1,350 page
-//! faults per extraction and doubled its time (3.8 → 7–9 ms); with normals on one thread, on the
-//! 128 × 128 × 84 MRI after other extractions in the same process, 6.7 → 5.0 ms. Kept here, an
-//! extraction allocates only its mesh.
+//! for every extraction and freed with it, that scratch tips glibc's `malloc` into returning the
+//! heap's top to the kernel after each call, so that the next call faults every page of its mesh
+//! in again, which can double a small extraction's time. Kept here, an extraction allocates only
+//! its mesh.
 
 use std::sync::Mutex;
 use std::vec::Vec;

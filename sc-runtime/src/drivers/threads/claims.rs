@@ -2,9 +2,8 @@
 //! finished its own chunk can take over the tail of another's.
 //!
 //! One chunk per thread, cut where the survey puts half the work, finishes together only when
-//! the threads run equally fast. This machine's two vCPUs often do not: brainsmall's first half
-//! took 2.1 ms on one and 3.0 ms on the other, in consecutive extractions, and the extraction
-//! waited for the slow one. Rayon's own work stealing cannot help: a chunk is one sweep, whose
+//! the threads run equally fast, and virtual CPUs often do not: the extraction then waits for
+//! the slow one. Rayon's own work stealing cannot help: a chunk is one sweep, whose
 //! layers must run in order on one thread. So the chunk's worker claims each layer here, and a
 //! thief can move the chunk's end down to a layer not yet claimed; the worker, at its next
 //! claim, hands over the room for the layers it gave up, and the thief sweeps them as a chunk of

@@ -104,8 +104,8 @@ struct Part {
 ///
 /// Each thread's scratch (about 13 bytes per sample of one z-slice) is kept for the next
 /// extraction, this one's or [`crate::extract`]'s, up to 64 MiB in all: allocated afresh, it
-/// made glibc hand the heap back to the kernel after every call and fault it in again on the
-/// next, which doubled the time of small extractions.
+/// makes glibc hand the heap back to the kernel after every call and fault it in again on the
+/// next, which can double the time of small extractions.
 ///
 /// ```
 /// use sc_runtime::{Params, Volume, demo, extract, extract_par};
@@ -354,11 +354,10 @@ fn in_pool<R: Send>(pool: Option<&rayon::ThreadPool>, job: impl FnOnce() -> R + 
 }
 
 /// One chunk per thread, of about equal work ([`balanced_bounds`]), and fewer chunks than threads
-/// when chunks would get fewer than [`MIN_CHUNK_LAYERS`]. Two per thread had balanced uneven
-/// surfaces when each sampled slice stood for the slices after it; with the estimate
-/// interpolated, they no longer finish apart, and every chunk after the first is moved when the
-/// output is joined and re-reads a plane at its seam: one per thread took 0.87–1.00× the time of
-/// two (`time_extract --threads 2`, two runs of alternating rounds on six volumes).
+/// when chunks would get fewer than [`MIN_CHUNK_LAYERS`]. More chunks would not balance the
+/// work better (the survey's estimate is interpolated, and a slow thread's tail is taken over,
+/// see `claims`), and every chunk after the first costs a move when the output is joined and a
+/// plane re-read at its seam.
 fn chunk_count(layers: usize, workers: usize) -> usize {
     layers.div_ceil(MIN_CHUNK_LAYERS).clamp(1, workers)
 }
@@ -420,10 +419,8 @@ fn stitch(out: &mut Mesh, parts: Vec<Part>) -> Result<(), Error> {
         triangles.push(p.triangles);
     }
     // The triangles beside the vertices' vectors, each join on every thread (`region::join`):
-    // the joins are copies of memory, and on large meshes they were a sixth of a two-thread
-    // extraction (the stent CT upsampled to 256³ at its skin: 21 of 128 ms) when one thread
-    // joined everything, and 12 of 117 ms with the triangles on one thread and the vertices on
-    // the other.
+    // the joins are copies of memory, a large share of a two-thread extraction of a large mesh
+    // when one thread does them all.
     let Mesh {
         positions: p,
         normals: n,

@@ -2,11 +2,10 @@
 //! own stretch of the vector's spare capacity, sized from the survey, and the stretches are then
 //! slid together in place.
 //!
-//! Chunk meshes of their own, copied into a fresh output, held the surface two and a half times
-//! over at the end of each extraction. glibc returned that memory to the kernel when it was
-//! freed, and the next extraction faulted it in again: on the 128 × 128 × 84 MRI about 1,400 page
-//! faults per two-thread extraction, 4.5 ms where the same work without trimming took 2.6 ms.
-//! Shared, the two-thread extraction allocates what the one-thread one does.
+//! Chunk meshes of their own, copied into a fresh output, would hold the surface two and a half
+//! times over at the end of each extraction, and glibc would return that memory to the kernel
+//! when it was freed, for the next extraction to fault in again. Shared, the two-thread
+//! extraction allocates what the one-thread one does.
 
 use alloc::vec::Vec;
 use core::mem::MaybeUninit;
@@ -141,8 +140,7 @@ const BLOCK: usize = 2048;
 /// The pieces are moved on every thread rayon has, in rounds: no piece lands on one not yet
 /// read. A part after the first moves down by the room left unused before it, so over the
 /// least such distance the moves of one round cannot meet (see [`Plan::new`]). On one thread the
-/// join of the triangles was three quarters of a large mesh's join and a tenth of its
-/// extraction (the stent CT at 256³ at its skin: 12 of 117 ms, the vertices' side 5 ms).
+/// join of a large mesh's triangles is a noticeable share of its extraction.
 ///
 /// # Safety
 /// `parts` are the finished stretches of [`stretches`] on this `buf` and those split off them

@@ -1,12 +1,10 @@
 //! The next slice to classify, fetched into the cache while the triangle pass runs.
 //!
 //! Classifying a slice is the only pass that reads every sample, and on large volumes it waits
-//! on memory: a quarter of the `f32` MNI brain's extraction (34.7 MB read at about 9.6 GB/s),
-//! while the other passes work from the cache. Spreading prefetches of slice `k + 3` over layer
-//! `k`'s triangle pass, a share per cube row, overlaps that read with the pass's work, so that
-//! layer `k + 1` classifies from L2: 0.89–0.93 times the time on the `f32` MNI brain, 0.92–0.94
-//! on the stent CT at 256³, 0.96–0.97 on the stent at 281 and the `u8` MNI brain, 0.98–0.99 on
-//! the small MRIs (`time_extract`, docs/speed-log.md).
+//! on memory while the other passes work from the cache. Spreading prefetches of slice `k + 3`
+//! over layer `k`'s triangle pass, a share per cube row, overlaps that read with the pass's work,
+//! so that layer `k + 1` classifies from L2; the larger the volume, the more it saves
+//! (docs/speed-log.md).
 
 use core::ops::Range;
 
