@@ -8,6 +8,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sc_runtime::{ErrorBound, ErrorUnits, Mode, UnknownName};
 
+use sc_io::limits;
 use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
 use sc_io::space::Coordinates;
@@ -423,22 +424,16 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
         })
         .collect::<Result<_, _>>()?;
     match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite() && c.abs() < 1e30) => Ok([*x, *y, *z]),
-        _ => Err("expected three finite numbers X,Y,Z (below 1e30: vertices are f32)".into()),
+        &[x, y, z] => limits::triple([x, y, z]),
+        _ => Err(limits::THREE_COORDINATES.into()),
     }
 }
 
-/// Threads beyond this are a mistake, not a machine: each costs a stack and a chunk of layers.
-const MAX_THREADS: usize = 1024;
-
 fn parse_threads(s: &str) -> Result<usize, String> {
-    let n: usize = s
+    let n: u64 = s
         .parse()
         .map_err(|_| format!("{s:?} is not a whole number"))?;
-    if n > MAX_THREADS {
-        return Err(format!("at most {MAX_THREADS} threads (0 uses every core)"));
-    }
-    Ok(n)
+    limits::threads(n)
 }
 
 fn parse_size(s: &str) -> Result<usize, String> {
