@@ -6,7 +6,6 @@
 //! A Fortran-order array of shape `(a, b, c)` is `nx = a, ny = b, nz = c`. Either way no sample is
 //! moved; only the shape is read in the right direction.
 
-use std::fs::File;
 use std::io::{self, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
@@ -27,7 +26,7 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     if !is_npz {
-        let mut file = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+        let mut file = BufReader::new(crate::input::open(path)?);
         check_header(&mut file).map_err(|m| not_readable(path, m))?;
         file.seek(SeekFrom::Start(0))
             .map_err(|e| Error::io(path, e))?;
