@@ -34,7 +34,7 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
             NpyHeader::from_reader(&mut file).map_err(|e| not_readable(path, e.to_string()))?;
         return read_array(path, &header, file, progress);
     }
-    let mut archive = NpzArchive::open(path)
+    let mut archive = NpzArchive::new(BufReader::new(crate::input::open(path)?))
         .map_err(|e| Error::file(path, format!("not a readable .npz archive: {e}")))?;
     let names: Vec<String> = archive.array_names().map(str::to_owned).collect();
     let name = match (array, names.as_slice()) {
