@@ -184,6 +184,15 @@ fn outputs_follow_links_and_refuse_special_files() {
     assert_eq!(entries(d), ["link.ply"]);
     assert_eq!(entries(elsewhere.path()), ["real.ply"]);
 
+    // A dangling link that leads to the mesh's own name would have its report overwrite it.
+    std::os::unix::fs::symlink("a.ply", d.join("s.json")).unwrap();
+    let args = [&demo[..], &["-o", "a.ply", "--stats-json", "s.json"]].concat();
+    let out = bounded(spawn(d, &args, &[]), "extract through a clashing link");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("is the same file"), "{stderr}");
+    std::fs::remove_file(d.join("s.json")).unwrap();
+
     mkfifo(&d.join("pipe.ply"));
     refused(
         d,
