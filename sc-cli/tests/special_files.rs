@@ -110,6 +110,14 @@ fn fifo_inputs_are_refused_not_waited_for() {
         );
         refused(d, &["info", input], "v.raw");
     }
+    // A sidecar given as the input that is itself a FIFO.
+    mkfifo(&d.join("side.json"));
+    refused(
+        d,
+        &["extract", "side.json", "--iso", "1", "-o", "out.ply"],
+        FIFO,
+    );
+    refused(d, &["info", "side.json"], FIFO);
     for mesh in ["m.ply", "m.obj", "m.stl"] {
         refused(d, &["render", mesh, "-o", "p.png"], FIFO);
     }
