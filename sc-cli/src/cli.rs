@@ -8,6 +8,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sc_runtime::{ErrorBound, ErrorUnits, Mode, UnknownName};
 
+use sc_io::limits;
 use sc_io::read::dicom::DicomOptions;
 use sc_io::read::{RawLayout, ReadOptions};
 use sc_io::space::Coordinates;
@@ -91,10 +92,10 @@ pub struct RenderArgs {
     #[arg(long, value_enum, conflicts_with_all = ["azimuth", "elevation"])]
     pub view: Option<View>,
     /// Degrees around the z axis (0 looks along +y).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_angle)]
     pub azimuth: Option<f64>,
     /// Degrees above the horizon (90 looks down).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_angle)]
     pub elevation: Option<f64>,
     /// Gouraud shading (normals averaged at vertices) instead of flat faces.
     #[arg(long)]
@@ -333,6 +334,7 @@ pub struct InfoArgs {
 #[derive(Debug, Args)]
 pub struct Table1Args {
     /// More volumes, each `FILE@ISO`, or just `FILE` to use its Otsu threshold.
+    #[arg(value_parser = parse_volume)]
     pub volumes: Vec<String>,
     /// Samples per axis of the built-in sphere, torus and noisy sphere (the knot is always 64,
     /// as in the paper; 2 to 512).
@@ -423,22 +425,16 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
         })
         .collect::<Result<_, _>>()?;
     match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite() && c.abs() < 1e30) => Ok([*x, *y, *z]),
-        _ => Err("expected three finite numbers X,Y,Z (below 1e30: vertices are f32)".into()),
+        &[x, y, z] => limits::triple([x, y, z]),
+        _ => Err(limits::THREE_COORDINATES.into()),
     }
 }
 
-/// Threads beyond this are a mistake, not a machine: each costs a stack and a chunk of layers.
-const MAX_THREADS: usize = 1024;
-
 fn parse_threads(s: &str) -> Result<usize, String> {
-    let n: usize = s
+    let n: u64 = s
         .parse()
         .map_err(|_| format!("{s:?} is not a whole number"))?;
-    if n > MAX_THREADS {
-        return Err(format!("at most {MAX_THREADS} threads (0 uses every core)"));
-    }
-    Ok(n)
+    limits::threads(n)
 }
 
 fn parse_size(s: &str) -> Result<usize, String> {
@@ -452,20 +448,39 @@ fn parse_size(s: &str) -> Result<usize, String> {
 }
 
 fn parse_max_error(s: &str) -> Result<f64, String> {
-    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
-    if v.is_finite() && v >= 0.0 {
+    let v = finite(s, "the bound")?;
+    if v >= 0.0 {
         Ok(v)
     } else {
-        Err("the bound must be a finite number, 0 or more".into())
+        Err(format!("the bound must be 0 or more, not {s}"))
     }
 }
 
 fn parse_iso(s: &str) -> Result<f64, String> {
+    finite(s, "the iso value")
+}
+
+/// A camera angle: NaN or infinity would put every point nowhere and draw a blank picture.
+fn parse_angle(s: &str) -> Result<f64, String> {
+    finite(s, "an angle")
+}
+
+fn finite(s: &str, what: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
     if v.is_finite() {
         Ok(v)
     } else {
-        Err("the iso value must be a finite number".into())
+        Err(format!("{what} must be a finite number, not {s}"))
+    }
+}
+
+/// A `table1` volume, `FILE@ISO` or `FILE`, whose iso value (if any) is finite.
+fn parse_volume(s: &str) -> Result<String, String> {
+    match split_iso(s) {
+        (_, Some(iso)) if !iso.is_finite() => Err(format!(
+            "the iso value after @ must be a finite number, not {iso}"
+        )),
+        _ => Ok(s.to_owned()),
     }
 }
 
@@ -526,6 +541,12 @@ mod tests {
         assert!(parse_triple("1,1e38,1").is_err());
         assert!(parse_iso("nan").is_err() && parse_iso("inf").is_err());
         assert_eq!(parse_iso("-2.5"), Ok(-2.5));
+        for bad in ["nan", "NaN", "inf", "-inf", "infinity"] {
+            assert!(parse_angle(bad).is_err(), "{bad}");
+            assert!(parse_volume(&format!("a.nii@{bad}")).is_err(), "{bad}");
+        }
+        assert_eq!(parse_angle("-400"), Ok(-400.0));
+        assert_eq!(parse_volume("a.nii@20"), Ok("a.nii@20".into()));
         assert!(parse_threads("100000").is_err());
         assert_eq!(parse_threads("8"), Ok(8));
         assert!(parse_size("2000").is_err() && parse_size("1").is_err());

@@ -2,6 +2,12 @@
 //! directory (so the final rename cannot cross file systems) and is renamed over the target only
 //! once complete. An error drops the temporary file; a signal handler can remove it with
 //! [`remove_pending`].
+//!
+//! A target that is a symbolic link is written through: the file the link points to is replaced
+//! (atomically, its temporary file made beside it) and the link is kept, as `>` in a shell or an
+//! editor's save would leave it. A target that is, or links to, a FIFO, a device or a socket is
+//! refused before anything is created: a rename would replace the special file with a regular
+//! one, and writing into it would not be atomic (a FIFO would wait for a reader).
 
 use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
@@ -28,7 +34,10 @@ pub fn remove_pending() {
 /// A file being written to a temporary name beside `target`.
 pub struct AtomicFile {
     temp: NamedTempFile,
+    /// The path as given, for messages.
     target: PathBuf,
+    /// Where the file goes: `target`, or the file its symbolic links lead to.
+    dest: PathBuf,
     _pending: Pending,
 }
 
@@ -52,14 +61,78 @@ impl Drop for Pending {
     }
 }
 
+/// Symbolic links followed before giving up, as Linux's `ELOOP` limit.
+const MAX_LINKS: usize = 40;
+
+/// The path an output written to `target` lands on: `target` itself, or the end of its chain of
+/// symbolic links (which need not exist yet: a dangling link creates its target). Relative links
+/// are resolved against the folder holding the link.
+pub fn destination(target: &Path) -> Result<PathBuf> {
+    let mut path = target.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&path) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let link = std::fs::read_link(&path).map_err(|e| Error::io(&path, e))?;
+                path = match path.parent() {
+                    Some(dir) => dir.join(link),
+                    None => link,
+                };
+            }
+            _ => return Ok(path),
+        }
+    }
+    Err(Error::file(
+        target,
+        format!("more than {MAX_LINKS} symbolic links lead from it"),
+    ))
+}
+
+/// What a special file is, in words, or `None` for a regular file (or nothing yet).
+#[cfg(unix)]
+fn special(meta: &std::fs::Metadata) -> Option<&'static str> {
+    use std::os::unix::fs::FileTypeExt;
+    let kind = meta.file_type();
+    if kind.is_file() {
+        None
+    } else if kind.is_fifo() {
+        Some("a FIFO")
+    } else if kind.is_socket() {
+        Some("a socket")
+    } else if kind.is_char_device() || kind.is_block_device() {
+        Some("a device")
+    } else {
+        Some("not a regular file")
+    }
+}
+
+#[cfg(not(unix))]
+fn special(meta: &std::fs::Metadata) -> Option<&'static str> {
+    (!meta.is_file()).then_some("not a regular file")
+}
+
 impl AtomicFile {
     /// Creates the temporary file now, so that a missing or unwritable directory is reported
-    /// before any slow work.
+    /// before any slow work. A symbolic link is written through; a target that is (or links to)
+    /// a folder, a FIFO, a device or a socket is refused (see the module's documentation).
     pub fn create(target: &Path) -> Result<Self> {
-        if target.is_dir() {
-            return Err(Error::file(target, "is a directory"));
+        let dest = destination(target)?;
+        let through = if dest == target {
+            String::new()
+        } else {
+            format!(" (a link to {})", dest.display())
+        };
+        if let Ok(meta) = std::fs::metadata(&dest) {
+            if meta.is_dir() {
+                return Err(Error::file(target, format!("is a directory{through}")));
+            }
+            if let Some(kind) = special(&meta) {
+                return Err(Error::file(
+                    target,
+                    format!("is {kind}{through}: outputs are written to regular files only"),
+                ));
+            }
         }
-        let dir = match target.parent() {
+        let dir = match dest.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => Path::new("."),
         };
@@ -69,7 +142,7 @@ impl AtomicFile {
                 format!("the directory {} does not exist", dir.display()),
             ));
         }
-        let name = target
+        let name = dest
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
@@ -101,6 +174,7 @@ impl AtomicFile {
         Ok(AtomicFile {
             temp,
             target: target.to_path_buf(),
+            dest,
             _pending: pending,
         })
     }
@@ -212,8 +286,10 @@ pub struct Filled(AtomicFile);
 impl Filled {
     /// Renames the file over its target.
     pub fn commit(self) -> Result<()> {
-        let AtomicFile { temp, target, .. } = self.0;
-        temp.persist(&target)
+        let AtomicFile {
+            temp, target, dest, ..
+        } = self.0;
+        temp.persist(&dest)
             .map(drop)
             .map_err(|e| Error::file(&target, format!("cannot write: {}", io_reason(&e.error))))
     }
@@ -316,6 +392,87 @@ mod tests {
             started >= 2 << 20 && started <= want.len() as u64,
             "{started}"
         );
+    }
+
+    /// A link is written through: the file it leads to (through a chain of relative and
+    /// absolute links, in another folder) gets the content, the links stay links, and neither
+    /// folder keeps a temporary file. A dangling link creates the file it names.
+    #[cfg(unix)]
+    #[test]
+    fn links_are_written_through() {
+        use std::os::unix::fs::symlink;
+        let here = tempfile::tempdir().unwrap();
+        let there = tempfile::tempdir().unwrap();
+        let real = there.path().join("real.ply");
+        std::fs::write(&real, b"old").unwrap();
+        symlink(&real, here.path().join("hop")).unwrap();
+        let link = here.path().join("mesh.ply");
+        symlink("hop", &link).unwrap();
+        assert_eq!(destination(&link).unwrap(), real);
+        AtomicFile::create(&link)
+            .unwrap()
+            .write_with(|w| w.write_all(b"new"))
+            .unwrap();
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
+        assert_eq!(entries(here.path()), ["hop", "mesh.ply"]);
+        assert_eq!(entries(there.path()), ["real.ply"]);
+
+        let dangling = here.path().join("new.ply");
+        symlink(there.path().join("made.ply"), &dangling).unwrap();
+        AtomicFile::create(&dangling)
+            .unwrap()
+            .write_with(|w| w.write_all(b"made"))
+            .unwrap();
+        assert_eq!(
+            std::fs::read(there.path().join("made.ply")).unwrap(),
+            b"made"
+        );
+        assert!(
+            dangling
+                .symlink_metadata()
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+
+        let looped = here.path().join("loop.ply");
+        symlink("loop.ply", &looped).unwrap();
+        let Err(err) = AtomicFile::create(&looped) else {
+            panic!()
+        };
+        assert!(err.to_string().contains("symbolic links"), "{err}");
+    }
+
+    /// A FIFO, or a link to a device, is refused by name before anything is created; the FIFO
+    /// and the link stay what they were.
+    #[cfg(unix)]
+    #[test]
+    fn special_files_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe.ply");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: mkfifo reads a NUL-terminated path that lives for the call.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let Err(err) = AtomicFile::create(&fifo) else {
+            panic!()
+        };
+        let err = err.to_string();
+        assert!(
+            err.contains("pipe.ply") && err.contains("is a FIFO"),
+            "{err}"
+        );
+        let null = dir.path().join("null.ply");
+        std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+        let Err(err) = AtomicFile::create(&null) else {
+            panic!()
+        };
+        let err = err.to_string();
+        assert!(err.contains("is a device (a link to /dev/null)"), "{err}");
+        assert_eq!(entries(dir.path()), ["null.ply", "pipe.ply"]);
+        use std::os::unix::fs::FileTypeExt;
+        assert!(fifo.symlink_metadata().unwrap().file_type().is_fifo());
+        assert!(null.symlink_metadata().unwrap().file_type().is_symlink());
     }
 
     #[test]

@@ -40,6 +40,8 @@
 pub mod atomic;
 mod buffer;
 mod error;
+mod input;
+pub mod limits;
 pub mod mesh_in;
 pub mod progress;
 pub mod read;

@@ -26,7 +26,7 @@ pub fn read(path: &Path) -> Result<TriangleMesh> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    let open = || File::open(path).map_err(|e| Error::io(path, e));
+    let open = || crate::input::open(path);
     let mesh = match ext.as_str() {
         "ply" => ply(path, open()?)?,
         "obj" => obj(path)?,
@@ -149,7 +149,7 @@ fn obj(path: &Path) -> Result<TriangleMesh> {
         ..Default::default()
     };
     let bad = |m: String| Error::file(path, format!("not a readable OBJ file: {m}"));
-    let mut reader = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+    let mut reader = BufReader::new(crate::input::open(path)?);
     // tobj multiplies a face's resolved normal and texture indices unchecked: an out-of-range
     // relative index overflows (a panic where overflow checks are on; found by fuzzing). And
     // materials are never loaded: only the geometry is used, and a `mtllib` line may name any

@@ -22,7 +22,6 @@
 //! a missing, damaged, foreign or duplicated shard is reported by file name instead of giving a
 //! wrong mesh.
 
-use std::fs::File;
 use std::io::{self, BufReader, Read, Seek, Write};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -440,7 +439,7 @@ where
 /// naming it, never a wrong mesh.
 pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
     let bad = |m: &str| Error::file(path, format!("not a readable shard: {m}"));
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::input::open(path)?;
     let limit = file.metadata().map_err(|e| Error::io(path, e))?.len();
     let mut npz = NpzArchive::new(BufReader::new(file)).map_err(|e| bad(&e.to_string()))?;
     let header: Vec<u8> = array(&mut npz, "header", 1, limit).map_err(|m| bad(&m))?;

@@ -376,10 +376,12 @@ fn check_outputs(input: Option<&Path>, mesh: &Path, stats: Option<&Path>) -> Res
     Ok(())
 }
 
-/// Whether two paths name the same file, whether or not it exists yet: the folder is resolved
-/// (links, `..`) and the names compared.
+/// Whether two paths name the same file, whether or not it exists yet: links are followed to
+/// where an output would land (a dangling link too), the folder is resolved (links, `..`) and
+/// the names compared.
 fn same_place(a: &Path, b: &Path) -> bool {
     let resolve = |p: &Path| -> Option<PathBuf> {
+        let p = &sc_io::atomic::destination(p).ok()?;
         if let Ok(full) = p.canonicalize() {
             return Some(full);
         }

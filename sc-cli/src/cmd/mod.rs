@@ -26,9 +26,8 @@ pub fn commit_with_report(
         }
         None => None,
     };
-    mesh.commit()?;
-    if let Some(filled) = report {
-        filled.commit()?;
-    }
-    Ok(())
+    crate::interrupt::finish(|| {
+        mesh.commit()?;
+        report.map_or(Ok(()), |filled| filled.commit())
+    })
 }

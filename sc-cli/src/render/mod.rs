@@ -176,7 +176,7 @@ pub fn run(args: &RenderArgs, quiet: bool) -> Result<()> {
             TEXT,
         );
     }
-    file.write_with(|out| {
+    let filled = file.fill(|out| {
         let mut encoder = png::Encoder::new(out, image.width as u32, image.height as u32);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
@@ -184,7 +184,8 @@ pub fn run(args: &RenderArgs, quiet: bool) -> Result<()> {
         writer
             .write_image_data(&image.rgb)
             .map_err(std::io::Error::other)
-    })
+    })?;
+    crate::interrupt::finish(|| filled.commit())
 }
 
 fn read(path: &Path) -> Result<TriangleMesh> {

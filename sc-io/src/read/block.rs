@@ -2,7 +2,6 @@
 //! keeps its samples in one block hands it to [`read_block`], so that byte order, compression,
 //! truncation and progress are handled once.
 
-use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
@@ -82,7 +81,7 @@ fn map_block(block: &Block<'_>) -> Result<Option<Samples>> {
         return Ok(None);
     };
     let path = block.path;
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::input::open(path)?;
     let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
     let start = match block.start {
         Start::At(offset) => offset,
@@ -104,7 +103,7 @@ pub(crate) fn open_block(block: &Block<'_>) -> Result<Box<dyn Read>> {
         .layout
         .bytes()
         .ok_or_else(|| Error::file(path, "the volume is too large"))? as u64;
-    let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut file = crate::input::open(path)?;
     let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
     let start = match block.start {
         Start::At(offset) => offset,

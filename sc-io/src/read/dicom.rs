@@ -6,7 +6,6 @@
 //! refused with the names of two files that disagree, since guessing which slices belong together
 //! silently builds a wrong volume.
 
-use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -281,7 +280,7 @@ fn dicom_files(dir: &Path) -> Result<Vec<PathBuf>> {
 
 fn has_preamble(path: &Path) -> Result<bool> {
     let mut head = [0u8; 132];
-    let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut file = crate::input::open(path)?;
     match file.read_exact(&mut head) {
         Ok(()) => Ok(&head[128..] == b"DICM"),
         Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Ok(false),

@@ -33,7 +33,7 @@ struct Encoding {
 /// file. A file the walk cannot follow (deflated data sets, garbage) is left to dicom-rs, which
 /// then reports its own error.
 pub(crate) fn check(path: &Path) -> Result<()> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::input::open(path)?;
     let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
     match Walk::new(BufReader::new(file), len).file() {
         Ok(_) | Err(Found::Unfollowable) => Ok(()),

@@ -1,14 +1,13 @@
 //! MetaImage (`.mha` with the data after the header, `.mhd` with a separate data file), raw or
 //! zlib-compressed. Like NRRD it is a short text header, so it shares [`super::header`].
 
-use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
 use super::block::{Block, Start, read_block};
 use super::header::{Syntax, TextHeader};
 use super::payload::{self, Encoding, Layout};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::progress::Progress;
 use crate::space::{Frame, Space};
 use crate::volume::{Dtype, Endian, Grid};
@@ -21,7 +20,7 @@ const SYNTAX: Syntax = Syntax {
 
 /// Reads a 3-D scalar MetaImage.
 pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
-    let mut reader = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+    let mut reader = BufReader::new(crate::input::open(path)?);
     let h = TextHeader::read(path, &mut reader, 0, &SYNTAX)?;
     drop(reader);
 

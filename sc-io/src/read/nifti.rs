@@ -2,7 +2,6 @@
 //! the samples go through [`read_block`] so that they land in their typed vector with one copy
 //! (the crate's volume types would hold a byte buffer and convert it again).
 
-use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
@@ -33,7 +32,7 @@ pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
 pub fn open(path: &Path) -> Result<(Grid, Block<'_>, Option<(f64, f64)>)> {
     let gz = path.to_string_lossy().to_ascii_lowercase().ends_with(".gz");
     let encoding = if gz { Encoding::Gzip } else { Encoding::Raw };
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::input::open(path)?;
     let header = NiftiHeader::from_reader(super::payload::decode(BufReader::new(file), encoding))
         .map_err(|e| match e {
         // The crate's own text for I/O errors is debug output; say it in words.

@@ -6,7 +6,6 @@
 //! A Fortran-order array of shape `(a, b, c)` is `nx = a, ny = b, nz = c`. Either way no sample is
 //! moved; only the shape is read in the right direction.
 
-use std::fs::File;
 use std::io::{self, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
@@ -27,7 +26,7 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     if !is_npz {
-        let mut file = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+        let mut file = BufReader::new(crate::input::open(path)?);
         check_header(&mut file).map_err(|m| not_readable(path, m))?;
         file.seek(SeekFrom::Start(0))
             .map_err(|e| Error::io(path, e))?;
@@ -35,7 +34,7 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
             NpyHeader::from_reader(&mut file).map_err(|e| not_readable(path, e.to_string()))?;
         return read_array(path, &header, file, progress);
     }
-    let mut archive = NpzArchive::open(path)
+    let mut archive = NpzArchive::new(BufReader::new(crate::input::open(path)?))
         .map_err(|e| Error::file(path, format!("not a readable .npz archive: {e}")))?;
     let names: Vec<String> = archive.array_names().map(str::to_owned).collect();
     let name = match (array, names.as_slice()) {

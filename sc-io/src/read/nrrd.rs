@@ -1,7 +1,6 @@
 //! NRRD (`.nrrd` with attached data, `.nhdr` with a detached data file), encodings raw and gzip.
 //! No maintained crate reads NRRD, and the part needed here is a short text header.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
@@ -21,7 +20,7 @@ const SYNTAX: Syntax = Syntax {
 
 /// Reads a 3-D scalar NRRD.
 pub fn read(path: &Path, progress: &dyn Progress) -> Result<Grid> {
-    let mut reader = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+    let mut reader = BufReader::new(crate::input::open(path)?);
     let mut magic = Vec::new();
     reader
         .read_until(b'\n', &mut magic)

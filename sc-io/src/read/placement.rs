@@ -16,7 +16,7 @@ pub(crate) fn check_placement(path: &Path, grid: &Grid) -> Result<()> {
             format!("the volume has no samples: its dims are {nx} × {ny} × {nz}"),
         ));
     }
-    let usable = |v: f64| v.is_finite() && v.abs() < 1e30;
+    let usable = crate::limits::coordinate;
     if !grid.spacing.iter().all(|&s| usable(s) && s > 0.0) {
         return Err(Error::file(
             path,

@@ -41,6 +41,8 @@ pub fn block<'a>(path: &'a Path, layout: &RawLayout) -> Result<Block<'a>> {
         count,
     };
     let need = block_layout.bytes().map(|b| b as u64 + layout.header_bytes);
+    // A FIFO's size is 0: name what it is, not a size mismatch.
+    crate::input::regular(path)?;
     let len = std::fs::metadata(path)
         .map_err(|e| Error::io(path, e))?
         .len();

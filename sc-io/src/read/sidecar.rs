@@ -46,7 +46,9 @@ pub fn find(path: &Path) -> Option<PathBuf> {
 impl Sidecar {
     /// Reads and checks the sidecar at `json`.
     pub fn read(json: &Path) -> Result<Sidecar> {
-        let text = std::fs::read_to_string(json).map_err(|e| Error::io(json, e))?;
+        let mut text = String::new();
+        std::io::Read::read_to_string(&mut crate::input::open(json)?, &mut text)
+            .map_err(|e| Error::io(json, e))?;
         let meta: Value = serde_json::from_str(&text)
             .map_err(|e| Error::file(json, format!("not valid JSON: {e}")))?;
         let field = |name: &str| meta.get(name).filter(|v| !v.is_null());
