@@ -197,8 +197,8 @@ impl AtomicFile {
         let fail =
             |e: io::Error| Error::file(&self.target, format!("cannot write: {}", io_reason(&e)));
         // 64 KiB: enough to batch the text formats' small writes. The binary writers hand over
-        // larger batches, which pass straight through; a 1 MiB buffer only added 256 pages to
-        // fault in (0.5 ms of a small scan's 15 ms run).
+        // larger batches, which pass straight through; a larger buffer only adds pages to fault
+        // in.
         let mut out = BufWriter::with_capacity(1 << 16, Output::new(self.temp.as_file()));
         fill(&mut out).map_err(fail)?;
         out.flush().map_err(fail)?;
@@ -210,7 +210,7 @@ impl AtomicFile {
 
 /// The temporary file as [`AtomicFile::fill`] writes it. On Linux, each mebibyte written is handed
 /// to the disk at once (`sync_file_range`), so that the `fsync` before the rename waits only for
-/// the last of it: on a 4.8 MB PLY that `fsync` took 3–4 ms, most of the run's fixed cost.
+/// the last of it, rather than for the whole file, which is most of a small run's fixed cost.
 pub struct Output<'a> {
     file: &'a File,
     /// Where the next write lands.

@@ -1,10 +1,10 @@
 //! Samples held in memory or mapped from their file.
 //!
 //! An uncompressed volume in this machine's byte order is already laid out as the extractor reads
-//! it, so it is mapped rather than copied: reading a 35 MB `f32` volume into fresh memory took
-//! 26 ms here (zeroing and faulting in the pages, then the kernel's copy), mapping it and reading
-//! it through 5 ms, and the page cache's copy is the only one in memory. nibabel maps NIfTI files
-//! the same way by default.
+//! it, so it is mapped rather than copied: reading it into fresh memory costs zeroing and
+//! faulting in the pages and then the kernel's copy, several times what mapping it and reading
+//! it through costs, and the page cache's copy is then the only one in memory. nibabel maps NIfTI
+//! files the same way by default.
 
 use std::fmt;
 use std::fs::File;
