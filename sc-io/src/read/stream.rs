@@ -124,7 +124,10 @@ impl Stream {
     fn check_slabs(&self) -> Result<()> {
         let [nx, ny, _] = self.grid.dims;
         let slices = self.slab().saturating_mul(2).saturating_add(4);
-        let what = format!("reading it {} slices of {nx} × {ny} samples at a time", self.slab());
+        let what = format!(
+            "streaming it in slabs of {} slices of {nx} × {ny} samples ({slices} slices held at once)",
+            self.slab()
+        );
         crate::limits::grid(
             [nx as u64, ny as u64, slices as u64],
             self.grid.samples.dtype().size(),
