@@ -41,6 +41,23 @@ fn v3_array(store: &Arc<FilesystemStore>, path: &str, shape: [u64; 3], data: &[i
     array.store_array_subset_elements(&all, data).unwrap();
 }
 
+/// Writes the stent as a Zarr v2 array at `dir`, uncompressed, written by hand: chunks of 16
+/// slices, the last one padded; only the first `files` chunks get a file.
+fn stent_v2(dir: &Path, files: usize) {
+    std::fs::create_dir(dir).unwrap();
+    std::fs::write(
+        dir.join(".zarray"),
+        r#"{"zarr_format": 2, "shape": [30, 40, 40], "chunks": [16, 40, 40], "dtype": "<i2",
+            "compressor": null, "fill_value": 0, "order": "C", "filters": null}"#,
+    )
+    .unwrap();
+    for (i, chunk) in stent().chunks(16 * 1600).enumerate().take(files) {
+        let mut bytes: Vec<u8> = chunk.iter().flat_map(|v| v.to_le_bytes()).collect();
+        bytes.resize(16 * 1600 * 2, 0);
+        std::fs::write(dir.join(format!("{i}.0.0")), bytes).unwrap();
+    }
+}
+
 /// The mesh bytes and the counts of `extract` with `args`.
 fn mesh(dir: &Path, args: &[&str]) -> (Vec<u8>, serde_json::Value) {
     skelclimb()
@@ -80,20 +97,7 @@ fn zarr_arrays_mesh_as_their_samples_do() {
         "v3 --stream"
     );
 
-    // Zarr v2, uncompressed, written by hand: chunks of 16 slices, the last one padded.
-    let v2 = d.join("v2");
-    std::fs::create_dir(&v2).unwrap();
-    std::fs::write(
-        v2.join(".zarray"),
-        r#"{"zarr_format": 2, "shape": [30, 40, 40], "chunks": [16, 40, 40], "dtype": "<i2",
-            "compressor": null, "fill_value": 0, "order": "C", "filters": null}"#,
-    )
-    .unwrap();
-    for (i, chunk) in data.chunks(16 * 1600).enumerate() {
-        let mut bytes: Vec<u8> = chunk.iter().flat_map(|v| v.to_le_bytes()).collect();
-        bytes.resize(16 * 1600 * 2, 0);
-        std::fs::write(v2.join(format!("{i}.0.0")), bytes).unwrap();
-    }
+    stent_v2(&d.join("v2"), 2);
     assert!(mesh(d, &["v2", "--iso", "281"]) == raw, "v2");
 }
 
@@ -283,11 +287,35 @@ fn lying_headers_are_refused_before_any_allocation() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let c = "[4, 4, 4]";
-    v2_store(&d.join("cube.zarr"), "[1000000, 1000000, 1000000]", c, "", 64);
+    v2_store(
+        &d.join("cube.zarr"),
+        "[1000000, 1000000, 1000000]",
+        c,
+        "",
+        64,
+    );
     v2_store(&d.join("tall.zarr"), "[1000000000000, 4, 4]", c, "", 64);
-    v2_store(&d.join("deep.zarr"), "[9223372036854775808, 4, 4]", c, "", 64);
-    v2_store(&d.join("wide.zarr"), "[4, 4, 9223372036854775807]", c, "", 64);
-    v2_store(&d.join("chunk.zarr"), "[4, 4, 4]", "[1000000, 1000000, 1000000]", "", 64);
+    v2_store(
+        &d.join("deep.zarr"),
+        "[9223372036854775808, 4, 4]",
+        c,
+        "",
+        64,
+    );
+    v2_store(
+        &d.join("wide.zarr"),
+        "[4, 4, 9223372036854775807]",
+        c,
+        "",
+        64,
+    );
+    v2_store(
+        &d.join("chunk.zarr"),
+        "[4, 4, 4]",
+        "[1000000, 1000000, 1000000]",
+        "",
+        64,
+    );
     let v3 = d.join("v3.zarr");
     std::fs::create_dir(&v3).unwrap();
     std::fs::write(
@@ -304,11 +332,26 @@ fn lying_headers_are_refused_before_any_allocation() {
         ("cube.zarr", "", "1000000 × 1000000 samples", false),
         ("cube.zarr", "--stream", "1000000 × 1000000 samples", false),
         ("v3.zarr", "", "1000000 × 1000000 samples", false),
-        ("tall.zarr", "", "4 × 4 × 1000000000000 samples would need 16.0 TB", true),
+        (
+            "tall.zarr",
+            "",
+            "4 × 4 × 1000000000000 samples would need 16.0 TB",
+            true,
+        ),
         ("deep.zarr", "", "4 × 4 × 9223372036854775808 samples", true),
         ("wide.zarr", "", "9223372036854775807 × 4 samples", false),
-        ("wide.zarr", "--stream", "9223372036854775807 × 4 samples", false),
-        ("chunk.zarr", "", "a chunk of shape [1000000, 1000000, 1000000]", false),
+        (
+            "wide.zarr",
+            "--stream",
+            "9223372036854775807 × 4 samples",
+            false,
+        ),
+        (
+            "chunk.zarr",
+            "",
+            "a chunk of shape [1000000, 1000000, 1000000]",
+            false,
+        ),
     ];
     for (store, flag, size, slabs_fit) in cases {
         let before = entries(d);
@@ -319,7 +362,11 @@ fn lying_headers_are_refused_before_any_allocation() {
             .stderr(contains(store))
             .stderr(contains(size))
             .stderr(contains("more than the"))
-            .stderr(if slabs_fit { hint.boxed() } else { hint.not().boxed() });
+            .stderr(if slabs_fit {
+                hint.boxed()
+            } else {
+                hint.not().boxed()
+            });
         assert_eq!(entries(d), before, "{store} {flag}: a file was left behind");
         limited(d, &format!("info {store}"))
             .assert()
@@ -374,20 +421,9 @@ fn missing_chunks_are_counted_and_reported() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let mut data = stent();
-    let v2 = d.join("half.zarr");
-    std::fs::create_dir(&v2).unwrap();
-    std::fs::write(
-        v2.join(".zarray"),
-        r#"{"zarr_format": 2, "shape": [30, 40, 40], "chunks": [16, 40, 40], "dtype": "<i2",
-            "compressor": null, "fill_value": 0, "order": "C", "filters": null}"#,
-    )
-    .unwrap();
     // Only the first chunk (slices 0 to 15) has a file.
-    let first: Vec<u8> = data[..16 * 1600]
-        .iter()
-        .flat_map(|v| v.to_le_bytes())
-        .collect();
-    std::fs::write(v2.join("0.0.0"), first).unwrap();
+    let v2 = d.join("half.zarr");
+    stent_v2(&v2, 1);
     data[16 * 1600..].fill(0);
     let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
     std::fs::write(d.join("s.raw"), bytes).unwrap();
@@ -406,7 +442,9 @@ fn missing_chunks_are_counted_and_reported() {
             .args(flag)
             .assert()
             .success()
-            .stderr(contains(format!("skelclimb: warning: half.zarr: {warning}")));
+            .stderr(contains(format!(
+                "skelclimb: warning: half.zarr: {warning}"
+            )));
         if flag.is_none() {
             let mut json: serde_json::Value =
                 serde_json::from_slice(&std::fs::read(d.join("m.json")).unwrap()).unwrap();
@@ -416,6 +454,14 @@ fn missing_chunks_are_counted_and_reported() {
             assert!((std::fs::read(d.join("m.ply")).unwrap(), json) == raw);
         }
     }
+    skelclimb()
+        .current_dir(d)
+        .args(["extract", "half.zarr", "--iso", "281", "--shards", "parts"])
+        .assert()
+        .success()
+        .stderr(contains(format!(
+            "skelclimb: warning: half.zarr: {warning}"
+        )));
     skelclimb()
         .current_dir(d)
         .args(["info", "half.zarr"])
@@ -440,7 +486,13 @@ fn a_store_with_the_wrong_separator_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let dotted = d.join("dotted.zarr");
-    v2_store(&dotted, "[8, 4, 4]", "[4, 4, 4]", r#", "dimension_separator": "/""#, 64);
+    v2_store(
+        &dotted,
+        "[8, 4, 4]",
+        "[4, 4, 4]",
+        r#", "dimension_separator": "/""#,
+        64,
+    );
     let nested = d.join("nested.zarr");
     v2_store(&nested, "[8, 4, 4]", "[4, 4, 4]", "", 64);
     std::fs::remove_file(nested.join("0.0.0")).unwrap();
@@ -459,9 +511,18 @@ fn a_store_with_the_wrong_separator_is_refused() {
     .unwrap();
     std::fs::write(v3.join("c/0/0/0"), [200u8; 64]).unwrap();
     for (store, message) in [
-        ("dotted.zarr", r#"0.0.0 exists: the chunk files separate their indices with ".", not the "/""#),
-        ("nested.zarr", r#"0/0/0 exists: the chunk files separate their indices with "/", not the ".""#),
-        ("v3.zarr", r#"c/0/0/0 exists: the chunk files separate their indices with "/", not the ".""#),
+        (
+            "dotted.zarr",
+            r#"0.0.0 exists: the chunk files separate their indices with ".", not the "/""#,
+        ),
+        (
+            "nested.zarr",
+            r#"0/0/0 exists: the chunk files separate their indices with "/", not the ".""#,
+        ),
+        (
+            "v3.zarr",
+            r#"c/0/0/0 exists: the chunk files separate their indices with "/", not the ".""#,
+        ),
     ] {
         for args in [
             vec!["extract", store, "--iso", "100", "-o", "m.ply"],
@@ -501,9 +562,21 @@ fn ome_transforms_must_be_numbers() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     for (name, scale, message) in [
-        ("word.zarr", serde_json::json!(["a", 1.0, 1.0]), r#"its `scale` transformation is ["a",1.0,1.0], not a list of 3 numbers"#),
-        ("short.zarr", serde_json::json!([1.0, 1.0]), "its `scale` transformation is [1.0,1.0], not a list of 3 numbers"),
-        ("none.zarr", serde_json::json!("x"), r#"its `scale` transformation is "x""#),
+        (
+            "word.zarr",
+            serde_json::json!(["a", 1.0, 1.0]),
+            r#"its `scale` transformation is ["a",1.0,1.0], not a list of 3 numbers"#,
+        ),
+        (
+            "short.zarr",
+            serde_json::json!([1.0, 1.0]),
+            "its `scale` transformation is [1.0,1.0], not a list of 3 numbers",
+        ),
+        (
+            "none.zarr",
+            serde_json::json!("x"),
+            r#"its `scale` transformation is "x""#,
+        ),
     ] {
         let store = Arc::new(FilesystemStore::new(d.join(name)).unwrap());
         let attrs = serde_json::json!({ "multiscales": [{ "datasets": [{ "path": "0",

@@ -145,7 +145,12 @@ pub fn load<'py>(
     for warning in &grid.warnings {
         let text = std::ffi::CString::new(warning.replace('\0', " "))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &text,
+            1,
+        )?;
     }
     let (affine, space) = world::affine(py, &grid)?;
     let Grid {

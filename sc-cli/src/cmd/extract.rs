@@ -336,6 +336,9 @@ fn request(args: &ExtractArgs, iso: f64) -> Request {
 fn shards(args: &ExtractArgs, dir: &Path, options: &ReadOptions, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
     let (mut grid, iso, input) = load(args, options, &progress)?;
+    for warning in &grid.warnings {
+        warn(warning);
+    }
     place(args, &mut grid, iso, &input)?;
     let block = args.block.unwrap_or(128) as usize;
     let manifest = surface::extract_shards(&grid, &request(args, iso), block, dir, &progress)?;

@@ -142,8 +142,12 @@ pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
     // zarrs decodes a whole chunk, whatever part of it a read needs.
     let chunk: Vec<u64> = chunk.iter().map(|c| c.get()).collect();
     let samples = chunk.iter().fold(1u128, |a, &c| a.saturating_mul(c.into()));
-    crate::limits::bytes(samples, dtype.size(), &format!("a chunk of shape {chunk:?}"))
-        .map_err(bad)?;
+    crate::limits::bytes(
+        samples,
+        dtype.size(),
+        &format!("a chunk of shape {chunk:?}"),
+    )
+    .map_err(bad)?;
     let chunk_z = usize::try_from(chunk[n - 3].min(shape[n - 3])).unwrap_or(usize::MAX);
     Ok((
         grid,
@@ -173,7 +177,11 @@ fn regular_metadata(dir: &Path) -> Result<()> {
 
 /// The OME-Zarr coordinate transformation `kind` ("scale" or "translation") of `dataset`, one
 /// number per axis of an array of `axes` axes; `None` if the dataset has none.
-fn transform(dataset: &Value, kind: &str, axes: usize) -> std::result::Result<Option<Vec<f64>>, String> {
+fn transform(
+    dataset: &Value,
+    kind: &str,
+    axes: usize,
+) -> std::result::Result<Option<Vec<f64>>, String> {
     let Some(found) = dataset
         .get("coordinateTransformations")
         .and_then(Value::as_array)
@@ -256,7 +264,8 @@ impl Source {
                 Ok(_) => crate::input::regular(&file)?,
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                     self.missing += 1;
-                    self.first_missing.get_or_insert_with(|| key.as_str().to_owned());
+                    self.first_missing
+                        .get_or_insert_with(|| key.as_str().to_owned());
                 }
                 Err(e) => return Err(Error::io(&file, e)),
             }
@@ -275,7 +284,11 @@ impl Source {
         if self.missing == self.chunks {
             // The key is the array's path, then the chunk's part: swap the separators there.
             let prefix = self.array.path().as_str().trim_start_matches('/');
-            let prefix = if prefix.is_empty() { String::new() } else { format!("{prefix}/") };
+            let prefix = if prefix.is_empty() {
+                String::new()
+            } else {
+                format!("{prefix}/")
+            };
             let chunk = key.strip_prefix(&prefix).unwrap_or(key);
             let other: String = chunk
                 .chars()
@@ -285,7 +298,11 @@ impl Source {
                     c => c,
                 })
                 .collect();
-            let (said, found) = if chunk.contains('/') { ("/", ".") } else { (".", "/") };
+            let (said, found) = if chunk.contains('/') {
+                ("/", ".")
+            } else {
+                (".", "/")
+            };
             if self.root.join(format!("{prefix}{other}")).is_file() {
                 return Err(Error::file(
                     &self.root,
