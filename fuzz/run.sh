@@ -7,9 +7,9 @@
 # corpus and survives a few thousand mutations; real campaigns use 600 seconds a target.
 #
 # Installs cargo-afl if it is missing and builds AFL++ once (cargo afl config --build), builds the
-# instrumented target (src/main.rs), then runs one afl-fuzz at a time (one core) on each reader,
-# starting from fuzz/corpus/<target>. AFL's findings go to fuzz/out/<target>/default/{crashes,hangs};
-# the script fails if any target has one. A finding becomes a file in fuzz/regressions/<target>/
+# instrumented target (src/main.rs; again with sc-io's `zarr` feature for the Zarr target), then
+# runs one afl-fuzz at a time (one core) on each reader, starting from fuzz/corpus/<target>.
+# AFL's findings go to fuzz/out/<target>/default/{crashes,hangs}; the script fails if any target has one. A finding becomes a file in fuzz/regressions/<target>/
 # (replayed by `cargo test -p sc-io --test fuzz_corpus`) and a fix in sc-io.
 #
 # Limits per input: 2 s (a hang beyond that is a finding) and 1 GiB of address space (a reader
@@ -20,7 +20,7 @@ cd "$(dirname "$0")"
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(nifti nifti_gz nrrd metaimage npy npz dicom sidecar ply obj stl)
+[ ${#targets[@]} -gt 0 ] || targets=(nifti nifti_gz nrrd metaimage npy npz dicom sidecar ply obj stl zarr)
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$PWD/target}
 
 if ! cargo afl --version >/dev/null 2>&1; then
@@ -36,6 +36,11 @@ cargo afl build --release --locked --bin read --bin zarr_off --target "$host"
 binary=$CARGO_TARGET_DIR/$host/release/read
 # sc-io is built here without its `zarr` feature: a Zarr store must be refused, naming it.
 "$CARGO_TARGET_DIR/$host/release/zarr_off"
+# The Zarr target is the same program built again with sc-io's `zarr` feature (`read_zarr`):
+# only sc-io and zarrs's crates are built for it, the rest is shared with the build above.
+if [[ " ${targets[*]} " == *" zarr "* ]]; then
+    cargo afl build --release --locked --features zarr --bin read_zarr --target "$host"
+fi
 
 # Containers and CI machines: no core_pattern or CPU frequency tuning, no pinning, no UI.
 export AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1 AFL_SKIP_CPUFREQ=1 AFL_NO_AFFINITY=1 AFL_NO_UI=1
@@ -47,8 +52,10 @@ for t in "${targets[@]}"; do
     out=out/$t
     rm -rf "$out"
     mkdir -p out
+    program=$binary
+    if [ "$t" = zarr ]; then program=${binary}_zarr; fi
     SC_FUZZ_TARGET=$t cargo afl fuzz -V "$seconds" -m 1024 -t 2000 -i "corpus/$t" -o "$out" \
-        -- "$binary" >"out/$t.log" 2>&1 || { echo "afl-fuzz failed on $t:"; tail -20 "out/$t.log"; exit 1; }
+        -- "$program" >"out/$t.log" 2>&1 || { echo "afl-fuzz failed on $t:"; tail -20 "out/$t.log"; exit 1; }
     stats=$out/default/fuzzer_stats
     field() { awk -v k="$1" '$1 == k { print $3 }' "$stats"; }
     crashes=$(find "$out/default/crashes" -type f ! -name README.txt | wc -l)

@@ -113,6 +113,49 @@ def stl_ascii():
     return ("solid t\n" + facets + "endsolid t\n").encode()
 
 
+# The files a Zarr input is cut into at NUL bytes, in order (fuzz/src/stage.rs, ZARR_FILES).
+ZARR_FILES = ["zarr.json", ".zarray", ".zgroup", ".zattrs", "0/zarr.json", "0/.zarray", "0.0.0",
+              "c/0/0/0", "0/0.0.0", "0/c/0/0/0"]
+# Chunk bytes must hold no NUL (it separates the files): 4×4×4 u8 and 4×4×2 i16 samples, 0 → 1.
+U8_CHUNK = U8[:64].replace(b"\0", b"\1")
+I16_CHUNK = I16[:64].replace(b"\0", b"\1")
+
+
+def zarr(files):
+    """One Zarr input: `files` (name → bytes or a JSON value) joined at NUL in ZARR_FILES order."""
+    as_bytes = lambda v: v if isinstance(v, bytes) else json.dumps(v, separators=(",", ":")).encode()
+    return b"\0".join(as_bytes(files[n]) if n in files else b"" for n in ZARR_FILES)
+
+
+def zarr_seeds():
+    v2 = {"zarr_format": 2, "shape": [4, 4, 4], "chunks": [4, 4, 4], "dtype": "|u1",
+          "compressor": None, "fill_value": 0, "order": "C", "filters": None}
+    write("zarr", "v2-u8", zarr({".zarray": v2, "0.0.0": U8_CHUNK}))
+    # i16, two chunks along z of which only the first has a file.
+    v2_i16 = dict(v2, shape=[4, 4, 4], chunks=[2, 4, 4], dtype="<i2", dimension_separator=".")
+    write("zarr", "v2-i16-missing", zarr({".zarray": v2_i16, "0.0.0": I16_CHUNK}))
+    v3 = {"zarr_format": 3, "node_type": "array", "shape": [4, 4, 4], "data_type": "uint8",
+          "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [4, 4, 4]}},
+          "chunk_key_encoding": {"name": "default"}, "fill_value": 0,
+          "codecs": [{"name": "bytes"}]}
+    write("zarr", "v3-u8", zarr({"zarr.json": v3, "c/0/0/0": U8_CHUNK}))
+    level = {"path": "0", "coordinateTransformations": [
+        {"type": "scale", "scale": [1.0, 2.0, 1.0, 1.0]},
+        {"type": "translation", "translation": [0.0, 1.0, 2.0, 3.0]}]}
+    multiscales = [{"axes": [{"name": "c", "type": "channel"}, {"name": "z", "type": "space"},
+                             {"name": "y", "type": "space"}, {"name": "x", "type": "space"}],
+                    "datasets": [level]}]
+    ome_v2 = dict(v2, shape=[1, 4, 4, 4], chunks=[1, 4, 4, 4])
+    write("zarr", "ome-v2", zarr({".zgroup": {"zarr_format": 2},
+                                  ".zattrs": {"multiscales": multiscales},
+                                  "0/.zarray": ome_v2, "0/0.0.0": U8_CHUNK}))
+    ome_v3 = dict(v3, shape=[1, 4, 4, 4],
+                  chunk_grid={"name": "regular", "configuration": {"chunk_shape": [1, 4, 4, 4]}})
+    group = {"zarr_format": 3, "node_type": "group",
+             "attributes": {"ome": {"version": "0.5", "multiscales": multiscales}}}
+    write("zarr", "ome-v3", zarr({"zarr.json": group, "0/zarr.json": ome_v3, "0/c/0/0/0": U8_CHUNK}))
+
+
 def main():
     write("nifti", "u8-qform.nii", nifti((8, 8, 8), 2, 8, U8, False))
     write("nifti", "i16-sform.nii", nifti((8, 8, 4), 4, 16, I16, True))
@@ -152,6 +195,7 @@ def main():
     write("obj", "quad-normals.obj", b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n")
     write("stl", "binary.stl", stl_binary())
     write("stl", "ascii.stl", stl_ascii())
+    zarr_seeds()
 
 
 if __name__ == "__main__":

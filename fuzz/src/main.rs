@@ -7,7 +7,8 @@ mod stage;
 
 use stage::Target;
 
-fn main() {
+/// Public for `src/read_zarr.rs`, the same target in sc-io's build with `zarr`.
+pub fn main() {
     let name = std::env::var("SC_FUZZ_TARGET").unwrap_or_default();
     let Some(target) = Target::ALL.into_iter().find(|t| t.name() == name) else {
         let names: Vec<&str> = Target::ALL.iter().map(|t| t.name()).collect();

@@ -38,11 +38,37 @@ pub enum Target {
     Obj,
     /// `m.stl`.
     Stl,
+    /// `v.zarr`, a Zarr store: the bytes, split at NUL bytes, are the files of
+    /// [`ZARR_FILES`] in turn (an empty part writes no file), so that one input holds v2 or v3
+    /// metadata, OME-Zarr attributes, a level's array and chunks. Read by the build with
+    /// sc-io's `zarr` feature (`read_zarr`).
+    Zarr,
 }
+
+/// The files a Zarr input is cut into, in order: a store's metadata at its root (v3, v2 array, v2
+/// group and attributes), an OME-Zarr level `0` (v3, v2), and the first chunk of each array under
+/// v2's and v3's default names.
+pub const ZARR_FILES: [&str; 10] = [
+    "zarr.json",
+    ".zarray",
+    ".zgroup",
+    ".zattrs",
+    "0/zarr.json",
+    "0/.zarray",
+    "0.0.0",
+    "c/0/0/0",
+    "0/0.0.0",
+    "0/c/0/0/0",
+];
+
+/// Samples a Zarr input may claim and still be read whole: reading costs time in proportion to
+/// the samples (and chunks) its header claims, whatever the store holds, and a slow read of a
+/// large claim is not a finding; the checks of the claim, on opening, are fuzzed at any size.
+const ZARR_READ_SAMPLES: usize = 1 << 16;
 
 impl Target {
     /// Every target, in the order `fuzz/run.sh` runs them.
-    pub const ALL: [Target; 11] = [
+    pub const ALL: [Target; 12] = [
         Target::Nifti,
         Target::NiftiGz,
         Target::Nrrd,
@@ -54,6 +80,7 @@ impl Target {
         Target::Ply,
         Target::Obj,
         Target::Stl,
+        Target::Zarr,
     ];
 
     /// The name of its binary and of its folders under `fuzz/corpus` and `fuzz/regressions`.
@@ -70,6 +97,7 @@ impl Target {
             Target::Ply => "ply",
             Target::Obj => "obj",
             Target::Stl => "stl",
+            Target::Zarr => "zarr",
         }
     }
 
@@ -109,6 +137,22 @@ impl Target {
             Target::Ply => file("m.ply", data),
             Target::Obj => file("m.obj", data),
             Target::Stl => file("m.stl", data),
+            Target::Zarr => {
+                let store = dir.join("v.zarr");
+                // AFL's persistent mode stages each input over the last: start afresh.
+                if store.exists() {
+                    std::fs::remove_dir_all(&store)?;
+                }
+                for (name, part) in ZARR_FILES.iter().zip(data.split(|&b| b == 0)) {
+                    if !part.is_empty() {
+                        let path = store.join(name);
+                        std::fs::create_dir_all(path.parent().unwrap_or(&store))?;
+                        std::fs::write(path, part)?;
+                    }
+                }
+                std::fs::create_dir_all(&store)?;
+                Ok(store)
+            }
         }
     }
 
@@ -125,6 +169,17 @@ impl Target {
                     mesh.triangles.iter().flatten().all(|&i| (i as usize) < n),
                     "a triangle indexes past the {n} vertices"
                 );
+            }
+            Target::Zarr => {
+                let options = ReadOptions::default();
+                let stream = sc_io::read::stream::open(path, &options)
+                    .map_err(|e| e.to_string())?
+                    .expect("a Zarr store streams");
+                let samples = (stream.grid.dims.iter()).try_fold(1usize, |n, &d| n.checked_mul(d));
+                if samples.is_some_and(|n| n <= ZARR_READ_SAMPLES) {
+                    let grid = read(path, &options, &Silent).map_err(|e| e.to_string())?;
+                    assert!(grid.dims.iter().product::<usize>() == grid.len());
+                }
             }
             _ => {
                 let grid =

@@ -324,6 +324,9 @@ pub struct Grid {
     pub format: &'static str,
     /// Facts the file states that the mesh does not use (e.g. a rotation), for `info`.
     pub notes: Vec<String>,
+    /// What the user must be told about the samples read (e.g. Zarr chunks that had no file and
+    /// read as the fill value): every front end shows them as warnings.
+    pub warnings: Vec<String>,
 }
 
 impl Grid {
@@ -338,6 +341,7 @@ impl Grid {
             scale: Linear::default(),
             format,
             notes: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 

@@ -91,7 +91,8 @@ fn rows<'a, T: numpy::Element>(
 /// shape `(nz, ny, nx)`, the 4×4 map from `(x, y, z, 1)` index to world coordinates, and the
 /// world's convention (`"RAS"`, `"LPS"`, or `None` for a file without a world frame). A rescale
 /// slope/intercept in the file is applied (to float32 for 8- and 16-bit samples, float64
-/// otherwise).
+/// otherwise). Zarr chunks that have no file read as the fill value, with a `UserWarning` that
+/// says how many there were.
 #[pyfunction]
 #[pyo3(signature = (path, *, dims=None, dtype=None, endian="little", header_bytes=0, array=None, series=None, resample_gaps=false, zarr_level=0))]
 #[allow(clippy::too_many_arguments)]
@@ -141,6 +142,16 @@ pub fn load<'py>(
     let grid = py
         .detach(|| sc_io::read::read(&path, &options, &Silent))
         .map_err(errors::io)?;
+    for warning in &grid.warnings {
+        let text = std::ffi::CString::new(warning.replace('\0', " "))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &text,
+            1,
+        )?;
+    }
     let (affine, space) = world::affine(py, &grid)?;
     let Grid {
         samples,

@@ -127,8 +127,10 @@ impl Sink for Mesh {
         // Reserve with a quarter to spare, and only when the hint outgrows the capacity, so the
         // buffers are reallocated a few times at most and never doubled past need.
         fn grow<T>(v: &mut Vec<T>, more: usize) {
+            // A hint, extrapolated from a volume's header: one the allocator refuses is dropped
+            // (the pushes grow the buffers as they need), rather than aborting the process.
             if v.capacity() - v.len() < more {
-                v.reserve_exact(more + more / 4);
+                let _ = v.try_reserve_exact(more.saturating_add(more / 4));
             }
         }
         grow(&mut self.positions, vertices);

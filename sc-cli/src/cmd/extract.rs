@@ -54,6 +54,9 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         Volume::Streamed(stream) => surface::extract_stream(stream, &request, &progress)?,
     };
     let extract_time = clock.elapsed();
+    for warning in &volume.grid().warnings {
+        warn(warning);
+    }
     if mesh.triangles.is_empty() {
         warn(format!(
             "{input}: {}; writing an empty mesh",
@@ -196,7 +199,19 @@ fn open_stream(
     if args.pad {
         Ok(None)
     } else if format == Format::Zarr {
-        stream::open(path, options)
+        // Streamed without being asked only if it would fit whole: a header that claims more
+        // is refused here, before the sweep allocates by it, unless --stream says to go on.
+        let stream = stream::open(path, options)?;
+        if let Some(stream) = &stream {
+            stream.check_whole().map_err(|e| match e {
+                Error::File { path, message } => Error::File {
+                    path,
+                    message: format!("{message}; --stream meshes it a few slices at a time"),
+                },
+                e => e,
+            })?;
+        }
+        Ok(stream)
     } else {
         // A header that does not open here is the whole read's to report, in its words.
         Ok(stream::open(path, options).ok().flatten().filter(too_big))
@@ -321,6 +336,9 @@ fn request(args: &ExtractArgs, iso: f64) -> Request {
 fn shards(args: &ExtractArgs, dir: &Path, options: &ReadOptions, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
     let (mut grid, iso, input) = load(args, options, &progress)?;
+    for warning in &grid.warnings {
+        warn(warning);
+    }
     place(args, &mut grid, iso, &input)?;
     let block = args.block.unwrap_or(128) as usize;
     let manifest = surface::extract_shards(&grid, &request(args, iso), block, dir, &progress)?;

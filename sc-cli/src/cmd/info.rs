@@ -195,6 +195,9 @@ pub fn describe(name: &str, grid: &Grid, bins: usize) -> String {
     for note in &grid.notes {
         let _ = writeln!(out, "  note      {note}");
     }
+    for warning in &grid.warnings {
+        let _ = writeln!(out, "  warning   {warning}");
+    }
     out
 }
 

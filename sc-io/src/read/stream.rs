@@ -73,12 +73,14 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
         Format::Zarr => {
             let (grid, source) = zarr::open(path, options.zarr_level)?;
             check_placement(path, &grid)?;
-            return Ok(Some(Stream {
+            let stream = Stream {
                 grid,
                 path: path.to_path_buf(),
                 source: Source::Zarr(Box::new(source)),
                 read: 0,
-            }));
+            };
+            stream.check_slabs()?;
+            return Ok(Some(stream));
         }
         _ => return Ok(None),
     };
@@ -101,6 +103,40 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<Option<Stream>> {
 const SLAB_BYTES: usize = 16 << 20;
 
 impl Stream {
+    /// Refuses a volume whose samples would not fit in this process's memory (see
+    /// [`crate::limits`]), naming the file and the size: before a whole read, which would abort
+    /// on the allocation. A stream that holds a few slabs at a time may still mesh it.
+    pub fn check_whole(&self) -> Result<()> {
+        let [nx, ny, nz] = self.grid.dims;
+        let what = format!("its {nx} × {ny} × {nz} samples");
+        crate::limits::grid(
+            [nx, ny, nz].map(|d| d as u64),
+            self.grid.samples.dtype().size(),
+            &what,
+        )
+        .map(drop)
+        .map_err(|e| Error::file(&self.path, e))
+    }
+
+    /// Refuses a stream whose slabs would not fit in memory: a header's slice size is checked
+    /// before any slab is allocated. A slab is held twice while it is decoded and copied, beside
+    /// the meshing's ring of a few slices.
+    fn check_slabs(&self) -> Result<()> {
+        let [nx, ny, _] = self.grid.dims;
+        let slices = self.slab().saturating_mul(2).saturating_add(4);
+        let what = format!(
+            "streaming it in slabs of {} slices of {nx} × {ny} samples ({slices} slices held at once)",
+            self.slab()
+        );
+        crate::limits::grid(
+            [nx as u64, ny as u64, slices as u64],
+            self.grid.samples.dtype().size(),
+            &what,
+        )
+        .map(drop)
+        .map_err(|e| Error::file(&self.path, e))
+    }
+
     /// z-slices per read that suit the source: a row of chunks for Zarr, about 16 MiB for files.
     pub(crate) fn slab(&self) -> usize {
         match &self.source {
@@ -118,7 +154,13 @@ impl Stream {
         let slices = slices.min(nz - self.read);
         let (z0, z1) = (self.read, self.read + slices);
         let samples = match &mut self.source {
-            Source::Zarr(z) => z.read::<T>(&self.path, z0, z1)?,
+            Source::Zarr(z) => {
+                let samples = z.read::<T>(&self.path, z0, z1)?;
+                if z1 == nz {
+                    self.grid.warnings.extend(z.missing_chunks()?);
+                }
+                samples
+            }
             Source::Block {
                 reader,
                 encoding,
@@ -145,10 +187,13 @@ impl Stream {
 
     /// Every sample, for a whole read.
     pub(crate) fn read_all(mut self, progress: &dyn Progress) -> Result<Grid> {
+        self.check_whole()?;
         let dtype = self.grid.samples.dtype();
         progress.phase("reading", self.grid.dims[2] as u64);
         let samples = crate::with_dtype!(dtype, T => {
             let mut all: Vec<T> = Vec::new();
+            all.try_reserve_exact(self.grid.dims.iter().product())
+                .map_err(|e| Error::file(&self.path, format!("its samples: {e}")))?;
             while self.read < self.grid.dims[2] {
                 let slab = self.slab();
                 let before = self.read;

@@ -1,8 +1,14 @@
 //! Zarr v2 and v3 arrays and OME-Zarr multiscale images, through the `zarrs` crate. Read a row of
 //! chunks at a time (see [`crate::read::stream`]), so a store larger than memory is meshed with
 //! the memory of one row of chunks plus the mesh.
+//!
+//! zarrs reads the store's files itself, not through [`crate::input`]: the metadata files and
+//! each chunk file a read needs are checked here first, so that a FIFO among them is refused
+//! instead of hanging the read. The same look counts the chunks that have no file: legal (they
+//! read as the fill value), but the user is told how many there were, and a store none of whose
+//! chunks is where its metadata says, but which has them under the other separator, is refused.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use serde_json::Value;
@@ -14,9 +20,19 @@ use zarrs::group::Group;
 use crate::error::{Error, Result};
 use crate::volume::{Dtype, Grid, Sample, Samples};
 
+/// The metadata files zarrs may read in a folder of the store (v3, then v2).
+const METADATA: [&str; 4] = ["zarr.json", ".zarray", ".zgroup", ".zattrs"];
+
 /// An open Zarr array, read a slab of z-slices at a time.
 pub struct Source {
     array: Array<FilesystemStore>,
+    /// The store's folder: chunk keys are paths below it.
+    root: PathBuf,
+    /// Chunks a read has needed so far, and those of them that have no file.
+    chunks: u64,
+    missing: u64,
+    /// The key of the first chunk that had no file.
+    first_missing: Option<String>,
     /// Leading axes of length 1 (OME-Zarr's `t` and `c`) before `z, y, x`.
     lead: usize,
     /// z-slices per chunk: slabs of whole chunk rows decode each chunk once.
@@ -29,6 +45,7 @@ pub struct Source {
 /// without its samples, and the source of its samples.
 pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
     let bad = |m: String| Error::file(path, m);
+    regular_metadata(path)?;
     let store = Arc::new(
         FilesystemStore::new(path).map_err(|e| bad(format!("not a readable Zarr store: {e}")))?,
     );
@@ -70,25 +87,20 @@ pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
                 .get("path")
                 .and_then(Value::as_str)
                 .ok_or_else(|| bad(format!("OME-Zarr dataset {level} has no `path`")))?;
-            let array = Array::open(store.clone(), &format!("/{}", sub.trim_matches('/')))
+            let sub = sub.trim_matches('/');
+            regular_metadata(&path.join(sub))?;
+            let array = Array::open(store.clone(), &format!("/{sub}"))
                 .map_err(|e| bad(format!("OME-Zarr level {level} ({sub}): {e}")))?;
-            let transform = |kind: &str| -> Option<Vec<f64>> {
-                dataset
-                    .get("coordinateTransformations")?
-                    .as_array()?
-                    .iter()
-                    .find(|t| t.get("type").and_then(Value::as_str) == Some(kind))?
-                    .get(kind)?
-                    .as_array()?
-                    .iter()
-                    .map(Value::as_f64)
-                    .collect()
+            let axes = array.shape().len();
+            let transform = |kind: &str| {
+                transform(dataset, kind, axes)
+                    .map_err(|e| bad(format!("OME-Zarr dataset {level} ({sub}): {e}")))
             };
             note = Some(format!(
                 "OME-Zarr image: level {level} ({sub}) of levels 0 to {}",
                 datasets.len() - 1
             ));
-            (array, transform("scale"), transform("translation"))
+            (array, transform("scale")?, transform("translation")?)
         }
     };
     let shape = array.shape().to_vec();
@@ -116,11 +128,7 @@ pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
     };
     let mut grid = Grid::new(Samples::empty(dtype), dims, "Zarr");
     // OME-Zarr lists transforms per axis, slowest first: the last three are z, y, x.
-    let xyz = |v: &Option<Vec<f64>>| {
-        v.as_ref()
-            .filter(|v| v.len() == n)
-            .map(|v| [v[n - 1], v[n - 2], v[n - 3]])
-    };
+    let xyz = |v: &Option<Vec<f64>>| v.as_ref().map(|v| [v[n - 1], v[n - 2], v[n - 3]]);
     if let Some(s) = xyz(&scale) {
         grid.spacing = s;
     }
@@ -128,19 +136,74 @@ pub fn open(path: &Path, level: usize) -> Result<(Grid, Source)> {
     if let Some(t) = xyz(&translation) {
         grid.origin = t;
     }
-    let chunk_z = array
+    let chunk = array
         .chunk_shape(&vec![0; n])
-        .map(|c| c[n - 3].get() as usize)
-        .unwrap_or(1);
+        .map_err(|e| bad(format!("its chunk grid: {e}")))?;
+    // zarrs decodes a whole chunk, whatever part of it a read needs.
+    let chunk: Vec<u64> = chunk.iter().map(|c| c.get()).collect();
+    let samples = chunk.iter().fold(1u128, |a, &c| a.saturating_mul(c.into()));
+    crate::limits::bytes(
+        samples,
+        dtype.size(),
+        &format!("a chunk of shape {chunk:?}"),
+    )
+    .map_err(bad)?;
+    let chunk_z = usize::try_from(chunk[n - 3].min(shape[n - 3])).unwrap_or(usize::MAX);
     Ok((
         grid,
         Source {
             array,
+            root: path.to_path_buf(),
+            chunks: 0,
+            missing: 0,
+            first_missing: None,
             lead: n - 3,
             chunk_z,
             dtype,
         },
     ))
+}
+
+/// Refuses a metadata file in the folder `dir` that is there but is not a regular file.
+fn regular_metadata(dir: &Path) -> Result<()> {
+    for name in METADATA {
+        let file = dir.join(name);
+        if std::fs::symlink_metadata(&file).is_ok() {
+            crate::input::regular(&file)?;
+        }
+    }
+    Ok(())
+}
+
+/// The OME-Zarr coordinate transformation `kind` ("scale" or "translation") of `dataset`, one
+/// number per axis of an array of `axes` axes; `None` if the dataset has none.
+fn transform(
+    dataset: &Value,
+    kind: &str,
+    axes: usize,
+) -> std::result::Result<Option<Vec<f64>>, String> {
+    let Some(found) = dataset
+        .get("coordinateTransformations")
+        .and_then(Value::as_array)
+        .and_then(|t| {
+            t.iter()
+                .find(|t| t.get("type").and_then(Value::as_str) == Some(kind))
+        })
+    else {
+        return Ok(None);
+    };
+    let value = found.get(kind);
+    let numbers = value
+        .and_then(Value::as_array)
+        .and_then(|v| v.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>())
+        .filter(|v| v.len() == axes);
+    match numbers {
+        Some(v) => Ok(Some(v)),
+        None => Err(format!(
+            "its `{kind}` transformation is {}, not a list of {axes} numbers (one per axis)",
+            value.map_or("missing".into(), Value::to_string)
+        )),
+    }
 }
 
 impl Source {
@@ -153,7 +216,7 @@ impl Source {
     /// machine's byte order, so its bytes are the samples; they are copied, since a byte buffer
     /// need not be aligned for `T`. (Read as bytes, a sample type needs no `zarrs` trait, and
     /// [`Sample`] does not depend on this reader.)
-    pub fn read<T: Sample>(&self, path: &Path, z0: usize, z1: usize) -> Result<Vec<T>> {
+    pub fn read<T: Sample>(&mut self, path: &Path, z0: usize, z1: usize) -> Result<Vec<T>> {
         let error =
             |e: &dyn std::fmt::Display| Error::file(path, format!("reading z {z0}..{z1}: {e}"));
         if T::DTYPE != self.dtype {
@@ -167,12 +230,97 @@ impl Source {
         let n = shape.len();
         let mut ranges = vec![0..1; self.lead];
         ranges.extend([z0 as u64..z1 as u64, 0..shape[n - 2], 0..shape[n - 1]]);
+        let subset = ArraySubset::new_with_ranges(&ranges);
+        self.look_for_chunks(&subset).map_err(|e| match e {
+            Error::File { .. } => e,
+            e => error(&e),
+        })?;
         let bytes = self
             .array
-            .retrieve_array_subset(&ArraySubset::new_with_ranges(&ranges))
+            .retrieve_array_subset(&subset)
             .map_err(|e| error(&e))?
             .into_fixed()
             .map_err(|e| error(&e))?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+}
+
+impl Source {
+    /// Checks the file of every chunk `subset` needs before zarrs opens it: a chunk file that is
+    /// not a regular file is refused, and one that is not there is counted.
+    fn look_for_chunks(&mut self, subset: &ArraySubset) -> Result<()> {
+        let chunks = self
+            .array
+            .chunks_in_array_subset(subset)
+            .ok()
+            .flatten()
+            .ok_or_else(|| Error::file(&self.root, "its chunk grid does not cover the array"))?;
+        for indices in &chunks.indices() {
+            let key = self.array.chunk_key(&indices);
+            let file = self.root.join(key.as_str());
+            self.chunks += 1;
+            match std::fs::metadata(&file) {
+                Ok(meta) if meta.is_file() => {}
+                Ok(_) => crate::input::regular(&file)?,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    self.missing += 1;
+                    self.first_missing
+                        .get_or_insert_with(|| key.as_str().to_owned());
+                }
+                Err(e) => return Err(Error::io(&file, e)),
+            }
+        }
+        Ok(())
+    }
+
+    /// After the last read: a warning that names how many chunks had no file, if any did. A
+    /// store none of whose chunks has a file where its metadata puts them, but whose first one
+    /// has a file under the other separator (`0/0/0` for `0.0.0`, or the reverse), is refused:
+    /// its metadata names the wrong separator, and reading it as all fill value would be wrong.
+    pub fn missing_chunks(&self) -> Result<Option<String>> {
+        let Some(key) = &self.first_missing else {
+            return Ok(None);
+        };
+        if self.missing == self.chunks {
+            // The key is the array's path, then the chunk's part: swap the separators there.
+            let prefix = self.array.path().as_str().trim_start_matches('/');
+            let prefix = if prefix.is_empty() {
+                String::new()
+            } else {
+                format!("{prefix}/")
+            };
+            let chunk = key.strip_prefix(&prefix).unwrap_or(key);
+            let other: String = chunk
+                .chars()
+                .map(|c| match c {
+                    '.' => '/',
+                    '/' => '.',
+                    c => c,
+                })
+                .collect();
+            let (said, found) = if chunk.contains('/') {
+                ("/", ".")
+            } else {
+                (".", "/")
+            };
+            if self.root.join(format!("{prefix}{other}")).is_file() {
+                return Err(Error::file(
+                    &self.root,
+                    format!(
+                        "none of its {} chunks is where its metadata puts them (such as {key}), \
+                         but {prefix}{other} exists: the chunk files separate their indices with \
+                         \"{found}\", not the \"{said}\" the metadata names \
+                         (`dimension_separator` in .zarray, `chunk_key_encoding` in zarr.json)",
+                        self.chunks
+                    ),
+                ));
+            }
+        }
+        Ok(Some(format!(
+            "{}: {} of its {} chunks have no file (such as {key}) and were read as the fill value",
+            self.root.display(),
+            self.missing,
+            self.chunks
+        )))
     }
 }

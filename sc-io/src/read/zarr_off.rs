@@ -23,7 +23,11 @@ impl Source {
         match *self {}
     }
 
-    pub fn read<T: Sample>(&self, _: &Path, _: usize, _: usize) -> Result<Vec<T>> {
+    pub fn read<T: Sample>(&mut self, _: &Path, _: usize, _: usize) -> Result<Vec<T>> {
+        match *self {}
+    }
+
+    pub fn missing_chunks(&self) -> Result<Option<String>> {
         match *self {}
     }
 }

@@ -273,7 +273,7 @@ impl<T: Scalar> Layers<T> for Sweep<'_, T> {
             // Layers done since this sweep started, and the ones left, extrapolate the output.
             let done = (k + 1 - self.first_layer) as u64;
             let left = (self.grid.dims[2] - 1).saturating_sub(k + 1) as u64;
-            let per = |n: u64| usize::try_from(n * left / done).unwrap_or(usize::MAX);
+            let per = |n: u64| usize::try_from(n.saturating_mul(left) / done).unwrap_or(usize::MAX);
             sink.expect(per(self.out.stats.vertices), per(self.out.stats.triangles));
         }
         Ok(())
