@@ -7,7 +7,10 @@ the output is committed. Only the standard library is used (no numpy)."""
 import gzip
 import io
 import json
+import os
 import struct
+import subprocess
+import tempfile
 import zipfile
 import zlib
 from pathlib import Path
@@ -113,6 +116,38 @@ def stl_ascii():
     return ("solid t\n" + facets + "endsolid t\n").encode()
 
 
+def shard_set(*args, world=None):
+    """A shard set that `skelclimb extract --demo sphere ... --shards` writes (SKELCLIMB names
+    the binary; the debug build by default), staged as the `shards` target reads it: the
+    manifest (its files renamed s0.npz, s1.npz, ...), a NUL, then each shard as a length and
+    its bytes; `members` selects the target's own zip (an even first byte) over the file as
+    it is (odd)."""
+    binary = os.environ.get("SKELCLIMB", str(HERE.parent / "target" / "debug" / "skelclimb"))
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([binary, "-q", "extract", "--demo", "sphere", *args, "--shards", tmp + "/s"],
+                       check=True)
+        manifest = json.loads(Path(tmp, "s", "manifest.json").read_text())
+        shards = [Path(tmp, "s", e["file"]).read_bytes() for e in manifest["shards"]]
+    for i, entry in enumerate(manifest["shards"]):
+        entry["file"] = "s%d.npz" % i
+    if world:
+        manifest["world"] = world
+    text = json.dumps(manifest, separators=(",", ":")).encode() + b"\0"
+    piece = lambda b: struct.pack("<I", len(b)) + b
+
+    def staged(members):
+        if not members:
+            return text + b"".join(piece(b"\x01" + s) for s in shards)
+        out = b""
+        for s in shards:
+            with zipfile.ZipFile(io.BytesIO(s)) as z:
+                names = ["header", "keys", "positions", "normals", "triangles", "cubes"]
+                out += piece(b"\x00" + b"".join(piece(z.read(n + ".npy")) for n in names))
+        return text + out
+
+    return staged
+
+
 def main():
     write("nifti", "u8-qform.nii", nifti((8, 8, 8), 2, 8, U8, False))
     write("nifti", "i16-sform.nii", nifti((8, 8, 4), 4, 16, I16, True))
@@ -152,6 +187,13 @@ def main():
     write("obj", "quad-normals.obj", b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n")
     write("stl", "binary.stl", stl_binary())
     write("stl", "ascii.stl", stl_ascii())
+    one = shard_set("--size", "6", "--block", "5")
+    write("shards", "one-as-is", one(members=False))
+    write("shards", "one-members", one(members=True))
+    lps = {"linear": [[0, 1, 0], [-1, 0, 0], [0, 0, 2]], "offset": [10, 20, 30], "space": "LPS"}
+    write("shards", "rotated-members", shard_set("--size", "6", "--block", "5", "--no-normals",
+                                                 world=lps)(members=True))
+    write("shards", "eight-members", shard_set("--size", "4", "--block", "2")(members=True))
 
 
 if __name__ == "__main__":
