@@ -34,7 +34,8 @@ pub fn read(path: &Path, array: Option<&str>, progress: &dyn Progress) -> Result
             NpyHeader::from_reader(&mut file).map_err(|e| not_readable(path, e.to_string()))?;
         return read_array(path, &header, file, progress);
     }
-    let mut archive = NpzArchive::open(path)
+    let file = BufReader::new(crate::input::open(path)?);
+    let mut archive = NpzArchive::new(file)
         .map_err(|e| Error::file(path, format!("not a readable .npz archive: {e}")))?;
     let names: Vec<String> = archive.array_names().map(str::to_owned).collect();
     let name = match (array, names.as_slice()) {
@@ -227,4 +228,22 @@ fn read_array(
     let samples =
         payload::read_samples(reader, layout, false, progress).map_err(|e| Error::io(path, e))?;
     Ok(Grid::new(samples, dims, "NumPy"))
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+
+    /// An `.npz` that is a FIFO is refused before it is opened, as an `.npy` one is: the zip
+    /// reader would otherwise wait for a writer forever.
+    #[test]
+    fn a_fifo_npz_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("v.npz");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: mkfifo reads a NUL-terminated path that lives for the call.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let e = read(&fifo, None, &crate::progress::Silent).unwrap_err();
+        assert!(e.to_string().contains("v.npz: is not a regular file"), "{e}");
+    }
 }
