@@ -278,10 +278,16 @@ fn merge_fails(d: &Path, manifest: &str, needle: &str) {
     assert!(entries(&d.join("out")).is_empty(), "{needle}");
 }
 
-fn edit_manifest(path: &Path, edit: impl FnOnce(&mut Vec<serde_json::Value>)) {
+/// Edits the manifest at `path` as JSON.
+fn edit_whole_manifest(path: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
     let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
-    edit(m["shards"].as_array_mut().unwrap());
+    edit(&mut m);
     std::fs::write(path, serde_json::to_vec(&m).unwrap()).unwrap();
+}
+
+/// Edits the list of shards of the manifest at `path`.
+fn edit_manifest(path: &Path, edit: impl FnOnce(&mut Vec<serde_json::Value>)) {
+    edit_whole_manifest(path, |m| edit(m["shards"].as_array_mut().unwrap()));
 }
 
 #[test]
@@ -376,49 +382,37 @@ fn overlapping_and_missing_blocks_are_refused() {
     sphere_shards(d, "p", &[]);
     let manifest = d.join("p/manifest.json");
     let original = std::fs::read(&manifest).unwrap();
-    edit_manifest(&manifest, |s| {
-        s.pop();
-    });
-    merge_fails(d, "p/manifest.json", "cover 6832 of the grid's 6859 cubes");
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| {
-        let first = s[0].clone();
-        s.push(first);
-    });
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "shard block-0-0-0.npz is listed twice",
-    );
-    // Two files whose boxes overlap by one layer of cubes: both named, with the cubes they share.
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| s[0]["cubes"][0][1] = 9.into());
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "shards block-0-0-0.npz and block-8-0-0.npz both own the cubes [8..9, 0..8, 0..8]",
-    );
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| s[0]["cubes"][1] = serde_json::json!([8, 2]));
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "its cubes along y run backwards, 8..2",
-    );
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| s[26]["cubes"][2][1] = 20.into());
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "cubes 16..20 along z leave the grid, which has cubes 0..19 there",
-    );
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| s[1]["file"] = "../p/block-0-0-0.npz".into());
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "not a shard manifest: a bad shard entry",
-    );
+    type Edit = fn(&mut Vec<serde_json::Value>);
+    let cases: [(Edit, &str); 6] = [
+        (|s| drop(s.pop()), "cover 6832 of the grid's 6859 cubes"),
+        (
+            |s| s.push(s[0].clone()),
+            "shard block-0-0-0.npz is listed twice",
+        ),
+        // Two files whose boxes overlap by one layer of cubes: both named, with the cubes
+        // they share.
+        (
+            |s| s[0]["cubes"][0][1] = 9.into(),
+            "shards block-0-0-0.npz and block-8-0-0.npz both own the cubes [8..9, 0..8, 0..8]",
+        ),
+        (
+            |s| s[0]["cubes"][1] = serde_json::json!([8, 2]),
+            "its cubes along y run backwards, 8..2",
+        ),
+        (
+            |s| s[26]["cubes"][2][1] = 20.into(),
+            "cubes 16..20 along z leave the grid, which has cubes 0..19 there",
+        ),
+        (
+            |s| s[1]["file"] = "../p/block-0-0-0.npz".into(),
+            "not a shard manifest: a bad shard entry",
+        ),
+    ];
+    for (edit, needle) in cases {
+        std::fs::write(&manifest, &original).unwrap();
+        edit_manifest(&manifest, edit);
+        merge_fails(d, "p/manifest.json", needle);
+    }
     std::fs::write(&manifest, b"{\"format\": \"something else\"}").unwrap();
     merge_fails(d, "p/manifest.json", "manifest.json: not a shard manifest");
 }
@@ -444,13 +438,6 @@ fn shard_options_are_checked() {
         .code(1)
         .stderr(contains("nothing.json: no such file"));
     assert!(entries(d).is_empty());
-}
-
-/// Edits the manifest at `path` as JSON.
-fn edit_whole_manifest(path: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
-    let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
-    edit(&mut m);
-    std::fs::write(path, serde_json::to_vec(&m).unwrap()).unwrap();
 }
 
 /// Names in a manifest are checked against the runtime's tables, and its numbers against the

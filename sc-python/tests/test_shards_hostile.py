@@ -16,17 +16,7 @@ import pytest
 
 import skelclimb
 import skelclimb.dask
-
-
-def blobs(shape, seed):
-    rng = np.random.default_rng(seed)
-    z, y, x = np.indices(shape, dtype=np.float32)
-    v = np.zeros(shape, np.float32)
-    for _ in range(4):
-        c = rng.uniform(0, 1, 3) * np.array(shape)
-        r = rng.uniform(3, 7)
-        v = np.maximum(v, r - np.sqrt((z - c[0]) ** 2 + (y - c[1]) ** 2 + (x - c[2]) ** 2))
-    return v
+from test_blocks import blobs
 
 
 @pytest.fixture
@@ -34,8 +24,8 @@ def shards(tmp_path):
     """A manifest of 27 shards of a (24, 23, 22) volume, and the mesh one extract gives."""
     v = blobs((24, 23, 22), 3)
     with dask.config.set(scheduler="sync"):
-        manifest = skelclimb.dask.extract(da.from_array(v, chunks=8), 0.5, shards=tmp_path / "p")
-    return manifest, skelclimb.extract(v, 0.5)
+        manifest = skelclimb.dask.extract(da.from_array(v, chunks=8), 12, shards=tmp_path / "p")
+    return manifest, skelclimb.extract(v, 12)
 
 
 def edit(manifest, change):
@@ -106,7 +96,7 @@ def test_a_manifest_s_numbers_and_names_are_checked(shards, at, value, message):
 def test_a_placement_past_f32_is_refused_not_written_as_infinity(tmp_path):
     v = blobs((20, 20, 20), 4)
     with dask.config.set(scheduler="sync"):
-        manifest = skelclimb.dask.extract(da.from_array(v, chunks=10), 0.5,
+        manifest = skelclimb.dask.extract(da.from_array(v, chunks=10), 12,
                                           spacing=(1e20, 1e20, 1e20), shards=tmp_path)
     edit(manifest, lambda m: m["world"]["linear"][2].__setitem__(2, 1e29))
     with pytest.raises(OSError, match="beyond what 32-bit floats hold"):
