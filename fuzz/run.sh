@@ -20,7 +20,7 @@ cd "$(dirname "$0")"
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(nifti nifti_gz nrrd metaimage npy npz dicom sidecar ply obj stl zarr)
+[ ${#targets[@]} -gt 0 ] || targets=(nifti nifti_gz nrrd metaimage npy npz dicom sidecar ply obj stl zarr shards)
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$PWD/target}
 
 if ! cargo afl --version >/dev/null 2>&1; then

@@ -7,7 +7,10 @@ the output is committed. Only the standard library is used (no numpy)."""
 import gzip
 import io
 import json
+import os
 import struct
+import subprocess
+import tempfile
 import zipfile
 import zlib
 from pathlib import Path
@@ -154,6 +157,36 @@ def zarr_seeds():
     group = {"zarr_format": 3, "node_type": "group",
              "attributes": {"ome": {"version": "0.5", "multiscales": multiscales}}}
     write("zarr", "ome-v3", zarr({"zarr.json": group, "0/zarr.json": ome_v3, "0/c/0/0/0": U8_CHUNK}))
+def shard_set(*args, world=None):
+    """A shard set that `skelclimb extract --demo sphere ... --shards` writes (SKELCLIMB names
+    the binary; the debug build by default), staged as the `shards` target reads it: the
+    manifest (its files renamed s0.npz, s1.npz, ...), a NUL, then each shard as a length and
+    its bytes; `members` selects the target's own zip (an even first byte) over the file as
+    it is (odd)."""
+    binary = os.environ.get("SKELCLIMB", str(HERE.parent / "target" / "debug" / "skelclimb"))
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([binary, "-q", "extract", "--demo", "sphere", *args, "--shards", tmp + "/s"],
+                       check=True)
+        manifest = json.loads(Path(tmp, "s", "manifest.json").read_text())
+        shards = [Path(tmp, "s", e["file"]).read_bytes() for e in manifest["shards"]]
+    for i, entry in enumerate(manifest["shards"]):
+        entry["file"] = "s%d.npz" % i
+    if world:
+        manifest["world"] = world
+    text = json.dumps(manifest, separators=(",", ":")).encode() + b"\0"
+    piece = lambda b: struct.pack("<I", len(b)) + b
+
+    def staged(members):
+        if not members:
+            return text + b"".join(piece(b"\x01" + s) for s in shards)
+        out = b""
+        for s in shards:
+            with zipfile.ZipFile(io.BytesIO(s)) as z:
+                names = ["header", "keys", "positions", "normals", "triangles", "cubes"]
+                out += piece(b"\x00" + b"".join(piece(z.read(n + ".npy")) for n in names))
+        return text + out
+
+    return staged
 
 
 def main():
@@ -196,6 +229,13 @@ def main():
     write("stl", "binary.stl", stl_binary())
     write("stl", "ascii.stl", stl_ascii())
     zarr_seeds()
+    one = shard_set("--size", "6", "--block", "5")
+    write("shards", "one-as-is", one(members=False))
+    write("shards", "one-members", one(members=True))
+    lps = {"linear": [[0, 1, 0], [-1, 0, 0], [0, 0, 2]], "offset": [10, 20, 30], "space": "LPS"}
+    write("shards", "rotated-members", shard_set("--size", "6", "--block", "5", "--no-normals",
+                                                 world=lps)(members=True))
+    write("shards", "eight-members", shard_set("--size", "4", "--block", "2")(members=True))
 
 
 if __name__ == "__main__":

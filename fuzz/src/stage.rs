@@ -43,6 +43,9 @@ pub enum Target {
     /// metadata, OME-Zarr attributes, a level's array and chunks. Read by the build with
     /// sc-io's `zarr` feature (`read_zarr`).
     Zarr,
+    /// `manifest.json` and its shards `s0.npz`, `s1.npz`, …, joined by [`sc_io::shard::merge`]:
+    /// see [`shards`] for how the bytes are cut.
+    Shards,
 }
 
 /// The files a Zarr input is cut into, in order: a store's metadata at its root (v3, v2 array, v2
@@ -68,7 +71,7 @@ const ZARR_READ_SAMPLES: usize = 1 << 16;
 
 impl Target {
     /// Every target, in the order `fuzz/run.sh` runs them.
-    pub const ALL: [Target; 12] = [
+    pub const ALL: [Target; 13] = [
         Target::Nifti,
         Target::NiftiGz,
         Target::Nrrd,
@@ -81,6 +84,7 @@ impl Target {
         Target::Obj,
         Target::Stl,
         Target::Zarr,
+        Target::Shards,
     ];
 
     /// The name of its binary and of its folders under `fuzz/corpus` and `fuzz/regressions`.
@@ -98,6 +102,7 @@ impl Target {
             Target::Obj => "obj",
             Target::Stl => "stl",
             Target::Zarr => "zarr",
+            Target::Shards => "shards",
         }
     }
 
@@ -153,6 +158,7 @@ impl Target {
                 std::fs::create_dir_all(&store)?;
                 Ok(store)
             }
+            Target::Shards => shards(dir, data),
         }
     }
 
@@ -180,6 +186,21 @@ impl Target {
                     let grid = read(path, &options, &Silent).map_err(|e| e.to_string())?;
                     assert!(grid.dims.iter().product::<usize>() == grid.len());
                 }
+            Target::Shards => {
+                let (_, mesh) = sc_io::shard::merge(path).map_err(|e| e.to_string())?;
+                let n = mesh.positions.len();
+                assert!(
+                    mesh.triangles.iter().flatten().all(|&i| (i as usize) < n),
+                    "a triangle indexes past the {n} vertices"
+                );
+                assert!(
+                    mesh.positions
+                        .iter()
+                        .chain(&mesh.normals)
+                        .flatten()
+                        .all(|c| c.is_finite()),
+                    "a vertex or normal is not finite"
+                );
             }
             _ => {
                 let grid =
@@ -202,4 +223,79 @@ impl Target {
             Err(text) => Err(format!("the error does not name the file: {text}")),
         }
     }
+}
+
+/// Stages a shard set: the bytes before the first NUL are `manifest.json`; the rest are shards,
+/// each a 32-bit little-endian length and that many bytes (fewer at the end), written as `s0.npz`,
+/// `s1.npz`, …. A shard whose first byte is odd is the rest as it is (fuzzing the zip layer);
+/// an even one is its six `.npy` members, each length-prefixed the same way, zipped here with
+/// their CRC-32s right, so that mutations reach the arrays behind the zip's checks.
+fn shards(dir: &Path, data: &[u8]) -> std::io::Result<PathBuf> {
+    const MEMBERS: [&str; 6] = [
+        "header",
+        "keys",
+        "positions",
+        "normals",
+        "triangles",
+        "cubes",
+    ];
+    fn pieces(mut data: &[u8]) -> impl Iterator<Item = &[u8]> {
+        std::iter::from_fn(move || {
+            let (len, rest) = data.split_first_chunk::<4>()?;
+            let len = (u32::from_le_bytes(*len) as usize).min(rest.len());
+            let piece;
+            (piece, data) = rest.split_at(len);
+            Some(piece)
+        })
+    }
+    let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
+    let manifest = dir.join("manifest.json");
+    std::fs::write(&manifest, &data[..split])?;
+    for (i, shard) in pieces(data.get(split + 1..).unwrap_or_default()).enumerate() {
+        let bytes = match shard.split_first() {
+            Some((mode, rest)) if mode % 2 == 0 => {
+                stored_zip(MEMBERS.iter().map(|m| format!("{m}.npy")).zip(pieces(rest)))
+            }
+            Some((_, rest)) => rest.to_vec(),
+            None => Vec::new(),
+        };
+        std::fs::write(dir.join(format!("s{i}.npz")), bytes)?;
+    }
+    Ok(manifest)
+}
+
+/// A zip archive of `members`, stored (uncompressed), as `numpy.savez` writes one.
+fn stored_zip(members: impl Iterator<Item = (String, impl AsRef<[u8]>)>) -> Vec<u8> {
+    let (mut out, mut directory, mut count) = (Vec::new(), Vec::new(), 0u16);
+    for (name, data) in members {
+        let data = data.as_ref();
+        let mut crc = flate2::Crc::new();
+        crc.update(data);
+        // Version 2.0, no flags, stored, no time: the fields a local and a central header share.
+        let mut common = vec![20, 0, 0, 0, 0, 0, 0, 0, 0, 0];
+        common.extend(crc.sum().to_le_bytes());
+        common.extend((data.len() as u32).to_le_bytes());
+        common.extend((data.len() as u32).to_le_bytes());
+        common.extend((name.len() as u16).to_le_bytes());
+        common.extend([0, 0]);
+        directory.extend(b"PK\x01\x02\x14\x00");
+        directory.extend(&common);
+        directory.extend([0; 10]);
+        directory.extend((out.len() as u32).to_le_bytes());
+        directory.extend(name.as_bytes());
+        out.extend(b"PK\x03\x04");
+        out.extend(&common);
+        out.extend(name.as_bytes());
+        out.extend(data);
+        count += 1;
+    }
+    let at = out.len() as u32;
+    out.extend(&directory);
+    out.extend(b"PK\x05\x06\x00\x00\x00\x00");
+    out.extend(count.to_le_bytes());
+    out.extend(count.to_le_bytes());
+    out.extend((directory.len() as u32).to_le_bytes());
+    out.extend(at.to_le_bytes());
+    out.extend([0, 0]);
+    out
 }

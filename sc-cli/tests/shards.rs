@@ -278,10 +278,16 @@ fn merge_fails(d: &Path, manifest: &str, needle: &str) {
     assert!(entries(&d.join("out")).is_empty(), "{needle}");
 }
 
-fn edit_manifest(path: &Path, edit: impl FnOnce(&mut Vec<serde_json::Value>)) {
+/// Edits the manifest at `path` as JSON.
+fn edit_whole_manifest(path: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
     let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
-    edit(m["shards"].as_array_mut().unwrap());
+    edit(&mut m);
     std::fs::write(path, serde_json::to_vec(&m).unwrap()).unwrap();
+}
+
+/// Edits the list of shards of the manifest at `path`.
+fn edit_manifest(path: &Path, edit: impl FnOnce(&mut Vec<serde_json::Value>)) {
+    edit_whole_manifest(path, |m| edit(m["shards"].as_array_mut().unwrap()));
 }
 
 #[test]
@@ -376,27 +382,37 @@ fn overlapping_and_missing_blocks_are_refused() {
     sphere_shards(d, "p", &[]);
     let manifest = d.join("p/manifest.json");
     let original = std::fs::read(&manifest).unwrap();
-    edit_manifest(&manifest, |s| {
-        s.pop();
-    });
-    merge_fails(d, "p/manifest.json", "cover 6832 of the grid's 6859 cubes");
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| {
-        let first = s[0].clone();
-        s.push(first);
-    });
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "shards block-0-0-0.npz and block-0-0-0.npz own the same cubes",
-    );
-    std::fs::write(&manifest, &original).unwrap();
-    edit_manifest(&manifest, |s| s[1]["file"] = "../p/block-0-0-0.npz".into());
-    merge_fails(
-        d,
-        "p/manifest.json",
-        "not a shard manifest: a bad shard entry",
-    );
+    type Edit = fn(&mut Vec<serde_json::Value>);
+    let cases: [(Edit, &str); 6] = [
+        (|s| drop(s.pop()), "cover 6832 of the grid's 6859 cubes"),
+        (
+            |s| s.push(s[0].clone()),
+            "shard block-0-0-0.npz is listed twice",
+        ),
+        // Two files whose boxes overlap by one layer of cubes: both named, with the cubes
+        // they share.
+        (
+            |s| s[0]["cubes"][0][1] = 9.into(),
+            "shards block-0-0-0.npz and block-8-0-0.npz both own the cubes [8..9, 0..8, 0..8]",
+        ),
+        (
+            |s| s[0]["cubes"][1] = serde_json::json!([8, 2]),
+            "its cubes along y run backwards, 8..2",
+        ),
+        (
+            |s| s[26]["cubes"][2][1] = 20.into(),
+            "cubes 16..20 along z leave the grid, which has cubes 0..19 there",
+        ),
+        (
+            |s| s[1]["file"] = "../p/block-0-0-0.npz".into(),
+            "not a shard manifest: a bad shard entry",
+        ),
+    ];
+    for (edit, needle) in cases {
+        std::fs::write(&manifest, &original).unwrap();
+        edit_manifest(&manifest, edit);
+        merge_fails(d, "p/manifest.json", needle);
+    }
     std::fs::write(&manifest, b"{\"format\": \"something else\"}").unwrap();
     merge_fails(d, "p/manifest.json", "manifest.json: not a shard manifest");
 }
@@ -422,4 +438,99 @@ fn shard_options_are_checked() {
         .code(1)
         .stderr(contains("nothing.json: no such file"));
     assert!(entries(d).is_empty());
+}
+
+/// Names in a manifest are checked against the runtime's tables, and its numbers against the
+/// limits every front end shares: each refusal says what is wrong, not "no settings".
+#[test]
+fn a_manifest_s_names_and_numbers_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    sphere_shards(d, "p", &[]);
+    let manifest = d.join("p/manifest.json");
+    let original = std::fs::read(&manifest).unwrap();
+    let cases: [(&str, serde_json::Value, &str); 6] = [
+        (
+            "/settings/mode",
+            "fast".into(),
+            "mode \"fast\": expected 'embedded', 'paper' or 'steps123'",
+        ),
+        (
+            "/settings/iso",
+            "0.5".into(),
+            "iso \"0.5\" is not a finite number",
+        ),
+        (
+            "/settings/spacing/1",
+            1e308.into(),
+            "settings: spacing [0.1,1e+308,0.1]",
+        ),
+        (
+            "/world/linear/0/0",
+            1e308.into(),
+            "world: linear row [1e+308,",
+        ),
+        ("/world/offset/2", 1e30.into(), "below 1e30"),
+        ("/world/space", "XYZ".into(), "space \"XYZ\" is neither"),
+    ];
+    for (at, value, needle) in cases {
+        std::fs::write(&manifest, &original).unwrap();
+        edit_whole_manifest(&manifest, |m| *m.pointer_mut(at).unwrap() = value);
+        merge_fails(d, "p/manifest.json", needle);
+    }
+}
+
+/// A placement whose numbers pass the limits but whose product with the vertices passes f32's
+/// range is refused, not written as infinities; a NaN or infinity inside a shard is refused
+/// naming the shard.
+#[test]
+fn no_infinity_or_nan_reaches_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    sphere_shards(d, "p", &["--spacing", "1e20,1e20,1e20"]);
+    let manifest = d.join("p/manifest.json");
+    let original = std::fs::read(&manifest).unwrap();
+    edit_whole_manifest(&manifest, |m| m["world"]["linear"][0][0] = 1e29.into());
+    merge_fails(d, "p/manifest.json", "beyond what 32-bit floats hold");
+    std::fs::write(&manifest, &original).unwrap();
+    let shard = d.join("p/block-8-8-8.npz");
+    let (block, settings) = sc_io::shard::read_shard(&shard).unwrap();
+    for (row, bad) in [(0, f32::NAN), (3, f32::INFINITY)] {
+        let mut b = block.clone();
+        b.positions[row][1] = bad;
+        write_shard(&shard, &b, &settings).unwrap();
+        merge_fails(
+            d,
+            "p/manifest.json",
+            &format!("block-8-8-8.npz: not a readable shard: positions row {row}"),
+        );
+        let mut b = block.clone();
+        b.normals[row][2] = bad;
+        write_shard(&shard, &b, &settings).unwrap();
+        merge_fails(d, "p/manifest.json", &format!("normals row {row}"));
+    }
+}
+
+/// A shard or a manifest that is a FIFO is refused at once (opening it would wait for a writer
+/// forever), naming it.
+#[cfg(unix)]
+#[test]
+fn a_fifo_is_refused_not_waited_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    sphere_shards(d, "p", &[]);
+    let fifo = |path: &Path| {
+        let _ = std::fs::remove_file(path);
+        let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+        // SAFETY: mkfifo reads a NUL-terminated path that lives for the call.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    };
+    fifo(&d.join("p/block-0-8-8.npz"));
+    merge_fails(
+        d,
+        "p/manifest.json",
+        "block-0-8-8.npz: is not a regular file",
+    );
+    fifo(&d.join("p/manifest.json"));
+    merge_fails(d, "p/manifest.json", "manifest.json: is not a regular file");
 }

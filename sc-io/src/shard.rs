@@ -33,6 +33,7 @@ use serde_json::{Value, json};
 
 use crate::atomic::AtomicFile;
 use crate::error::{Error, Result};
+use crate::limits;
 use crate::report;
 use crate::space::{Space, World};
 
@@ -102,24 +103,50 @@ impl Settings {
         })
     }
 
-    fn from_json(v: &Value) -> Option<Settings> {
-        let mode = v["mode"].as_str()?.parse().ok()?;
+    /// The settings `v` holds, or what is wrong with them: an unknown mode or units name lists
+    /// the valid ones, and every number must be one the extractor can use ([`limits`]).
+    fn from_json(v: &Value) -> std::result::Result<Settings, String> {
+        let mode = v["mode"]
+            .as_str()
+            .ok_or("settings: no mode")?
+            .parse::<Mode>()
+            .map_err(|e| format!("settings: mode {}: {e}", v["mode"]))?;
         let max_error = match &v["max_error"] {
             Value::Null => None,
-            b => Some(ErrorBound::new(
-                b["value"].as_f64()?,
-                b["units"].as_str()?.parse().ok()?,
-            )),
+            b => {
+                let value = b["value"]
+                    .as_f64()
+                    .filter(|x| x.is_finite() && *x >= 0.0)
+                    .ok_or_else(|| format!("settings: max_error {b} has no finite value"))?;
+                let units = b["units"]
+                    .as_str()
+                    .ok_or_else(|| format!("settings: max_error {b} has no units"))?
+                    .parse()
+                    .map_err(|e| format!("settings: max_error units {}: {e}", b["units"]))?;
+                Some(ErrorBound::new(value, units))
+            }
         };
-        Some(Settings {
-            iso: v["iso"].as_f64()?,
+        let iso = v["iso"]
+            .as_f64()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("settings: iso {} is not a finite number", v["iso"]))?;
+        let normals = v["normals"].as_bool().ok_or("settings: no normals flag")?;
+        Ok(Settings {
+            iso,
             mode,
-            normals: v["normals"].as_bool()?,
-            spacing: triple(&v["spacing"])?,
-            origin: triple(&v["origin"])?,
+            normals,
+            spacing: coordinates(&v["spacing"], "settings: spacing")?,
+            origin: coordinates(&v["origin"], "settings: origin")?,
             max_error,
         })
     }
+}
+
+/// Three numbers at `v`, each a coordinate the extractor can use ([`limits::triple`]).
+fn coordinates(v: &Value, what: &str) -> std::result::Result<[f64; 3], String> {
+    triple(v)
+        .ok_or_else(|| format!("{what} {v}: {}", limits::THREE_COORDINATES))
+        .and_then(|t| limits::triple(t).map_err(|e| format!("{what} {v}: {e}")))
 }
 
 fn triple(v: &Value) -> Option<[f64; 3]> {
@@ -170,8 +197,12 @@ impl ShardEntry {
         )
     }
 
+    /// Cubes in the box; the manifest's reader has checked that the box is inside a grid
+    /// whose cube count fits in 64 bits, elsewhere it saturates.
     fn count(&self) -> u64 {
-        self.cubes.iter().map(|r| r.len() as u64).product()
+        self.cubes
+            .iter()
+            .fold(1u64, |n, r| n.saturating_mul(r.len() as u64))
     }
 }
 
@@ -230,7 +261,10 @@ impl Manifest {
     /// Reads a manifest and checks that its shards are distinct files owning disjoint boxes of
     /// cubes that together cover the grid.
     pub fn read(path: &Path) -> Result<Manifest> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let mut bytes = Vec::new();
+        crate::input::open(path)?
+            .read_to_end(&mut bytes)
+            .map_err(|e| Error::io(path, e))?;
         let bad = |m: &str| Error::file(path, format!("not a shard manifest: {m}"));
         let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(&e.to_string()))?;
         if v["format"] != MANIFEST_FORMAT {
@@ -246,8 +280,8 @@ impl Manifest {
             ));
         }
         let grid = usizes(&v["grid"]).ok_or_else(|| bad("no grid"))?;
-        let settings = Settings::from_json(&v["settings"]).ok_or_else(|| bad("no settings"))?;
-        let world = world_from_json(&v["world"]).ok_or_else(|| bad("no world placement"))?;
+        let settings = Settings::from_json(&v["settings"]).map_err(|m| bad(&m))?;
+        let world = world_from_json(&v["world"]).map_err(|m| bad(&m))?;
         let shards = v["shards"]
             .as_array()
             .ok_or_else(|| bad("no list of shards"))?
@@ -267,12 +301,31 @@ impl Manifest {
     /// Every cube of the grid in exactly one listed shard, found from the boxes alone so that
     /// the message can name the files.
     fn check_cover(&self, path: &Path) -> Result<()> {
+        let refuse = |m: String| Err(Error::file(path, m));
+        let cubes = self.grid.map(|n| n.saturating_sub(1));
+        let total = cubes.iter().try_fold(1u64, |n, &c| n.checked_mul(c as u64));
+        let Some(total) = total else {
+            return refuse(format!(
+                "a {:?} grid has more cubes than a 64-bit count holds",
+                self.grid
+            ));
+        };
+        let mut files = std::collections::HashSet::new();
         for s in &self.shards {
+            if !files.insert(s.file.as_str()) {
+                return refuse(format!("shard {} is listed twice", s.file));
+            }
             for (d, r) in s.cubes.iter().enumerate() {
-                if r.start > r.end || r.end > self.grid[d].saturating_sub(1) {
-                    return Err(Error::file(
-                        path,
-                        format!("shard {}: its cubes leave the grid", s.file),
+                if r.start > r.end {
+                    return refuse(format!(
+                        "shard {}: its cubes along {} run backwards, {}..{}",
+                        s.file, AXES[d], r.start, r.end
+                    ));
+                }
+                if r.end > cubes[d] {
+                    return refuse(format!(
+                        "shard {}: its cubes {}..{} along {} leave the grid, which has cubes 0..{} there",
+                        s.file, r.start, r.end, AXES[d], cubes[d]
                     ));
                 }
             }
@@ -284,53 +337,59 @@ impl Manifest {
                 if b.cubes[2].start >= a.cubes[2].end {
                     break;
                 }
-                if a.file == b.file || (0..3).all(|d| overlap(&a.cubes[d], &b.cubes[d])) {
-                    return Err(Error::file(
-                        path,
-                        format!("shards {} and {} own the same cubes", a.file, b.file),
+                if (0..3).all(|d| overlap(&a.cubes[d], &b.cubes[d])) {
+                    let both: [Range<usize>; 3] = std::array::from_fn(|d| {
+                        a.cubes[d].start.max(b.cubes[d].start)..a.cubes[d].end.min(b.cubes[d].end)
+                    });
+                    return refuse(format!(
+                        "shards {} and {} both own the cubes {both:?} (x, y, z)",
+                        a.file, b.file
                     ));
                 }
             }
         }
+        // Disjoint boxes inside the grid: their counts sum to at most `total`.
         let covered: u64 = self.shards.iter().map(ShardEntry::count).sum();
-        let cubes: u64 = self
-            .grid
-            .iter()
-            .map(|&n| n.saturating_sub(1) as u64)
-            .product();
-        if covered != cubes {
-            return Err(Error::file(
-                path,
-                format!(
-                    "the shards cover {covered} of the grid's {cubes} cubes: blocks are missing"
-                ),
+        if covered != total {
+            return refuse(format!(
+                "the shards cover {covered} of the grid's {total} cubes: blocks are missing"
             ));
         }
         Ok(())
     }
 }
 
+/// Axis names for messages.
+const AXES: [&str; 3] = ["x", "y", "z"];
+
 fn overlap(a: &Range<usize>, b: &Range<usize>) -> bool {
     a.start < b.end && b.start < a.end
 }
 
-fn world_from_json(v: &Value) -> Option<World> {
-    let rows = v["linear"].as_array()?;
-    let linear = match rows.as_slice() {
-        [a, b, c] => [triple(a)?, triple(b)?, triple(c)?],
-        _ => return None,
-    };
+/// The placement `v` holds, every entry a coordinate the extractor can use ([`limits`]), so
+/// that placing a finite mesh cannot overflow unless its own numbers are near `f32`'s end.
+fn world_from_json(v: &Value) -> std::result::Result<World, String> {
+    let rows = v["linear"]
+        .as_array()
+        .filter(|r| r.len() == 3)
+        .ok_or_else(|| format!("world: linear {} is not three rows", v["linear"]))?;
+    let linear = [0, 1, 2].map(|r| coordinates(&rows[r], "world: linear row"));
+    let [a, b, c] = linear;
     let space = match &v["space"] {
         Value::Null => None,
-        s => Some(match s.as_str()? {
-            "RAS" => Space::Ras,
-            "LPS" => Space::Lps,
-            _ => return None,
+        s => Some(match s.as_str() {
+            Some("RAS") => Space::Ras,
+            Some("LPS") => Space::Lps,
+            _ => {
+                return Err(format!(
+                    "world: space {s} is neither \"RAS\", \"LPS\" nor null"
+                ));
+            }
         }),
     };
-    Some(World {
-        linear,
-        offset: triple(&v["offset"])?,
+    Ok(World {
+        linear: [a?, b?, c?],
+        offset: coordinates(&v["offset"], "world: offset")?,
         space,
     })
 }
@@ -454,7 +513,7 @@ pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
             header["version"]
         )));
     }
-    let settings = Settings::from_json(&header["settings"]).ok_or_else(|| bad("no settings"))?;
+    let settings = Settings::from_json(&header["settings"]).map_err(|m| bad(&m))?;
     let block = BlockMesh {
         grid: usizes(&header["grid"]).ok_or_else(|| bad("no grid"))?,
         stats: stats_from_json(&header["stats"]).ok_or_else(|| bad("no counts"))?,
@@ -468,6 +527,14 @@ pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
         cubes: array(&mut npz, "cubes", 1, limit).map_err(|m| bad(&m))?,
     };
     block.check().map_err(|e| bad(&e.to_string()))?;
+    for (name, rows) in [("positions", &block.positions), ("normals", &block.normals)] {
+        if let Some(i) = rows.iter().position(|r| !r.iter().all(|c| c.is_finite())) {
+            return Err(bad(&format!(
+                "{name} row {i} is {:?}: not finite numbers",
+                rows[i]
+            )));
+        }
+    }
     Ok((block, settings))
 }
 
@@ -476,7 +543,10 @@ pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
 /// The entry is read whole first, so that the zip reader reaches its end and checks the CRC-32
 /// the writer recorded: a flipped byte in a shard is then an error, not a wrong vertex. Shards
 /// are stored uncompressed, so no entry can be longer than the file, `limit`.
-fn array<T: npyz::Deserialize, R: Read + Seek>(
+///
+/// An `(n, width)` array in Fortran order (NumPy's `fortran_order: True`, as `np.asfortranarray`
+/// or a transposed view gives) is transposed into rows, so it means what it means to NumPy.
+fn array<T: npyz::Deserialize + Copy, R: Read + Seek>(
     npz: &mut NpzArchive<R>,
     name: &str,
     width: usize,
@@ -507,7 +577,20 @@ fn array<T: npyz::Deserialize, R: Read + Seek>(
     if !fits {
         return Err(format!("array {name} has shape {shape:?}"));
     }
-    npy.into_vec().map_err(|e| format!("array {name}: {e}"))
+    let order = npy.header().order();
+    let flat = npy.into_vec().map_err(|e| format!("array {name}: {e}"))?;
+    Ok(match order {
+        npyz::Order::C => flat,
+        // NumPy writes a Fortran-order (column-major) array column by column: the rows' first
+        // elements, then their second ones, and so on.
+        npyz::Order::Fortran => {
+            let n = flat.len() / width;
+            (0..n)
+                .flat_map(|i| (0..width).map(move |j| j * n + i))
+                .map(|k| flat[k])
+                .collect()
+        }
+    })
 }
 
 fn rows<T: Copy>(flat: Vec<T>) -> Vec<[T; 3]> {
@@ -543,6 +626,20 @@ pub fn merge(manifest_path: &Path) -> Result<(Manifest, Mesh)> {
         .map_err(|e| Error::file(manifest_path, e))?;
     if !manifest.world.is_translation() {
         manifest.world.place(&mut mesh);
+        // Every number of the placement is below 1e30 and every shard's position finite, but
+        // their product can still pass f32's largest value: refuse rather than write infinities.
+        if let Some(p) = mesh
+            .positions
+            .iter()
+            .find(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::file(
+                manifest_path,
+                format!(
+                    "the world placement takes a vertex to {p:?}, beyond what 32-bit floats hold"
+                ),
+            ));
+        }
     }
     Ok((manifest, mesh))
 }
@@ -621,5 +718,82 @@ mod tests {
         let positions = npz.by_name("positions").unwrap().unwrap();
         assert_eq!(positions.shape(), [block.keys.len() as u64, 3]);
         assert_eq!(positions.dtype().descr(), "'<f4'");
+    }
+
+    /// `path` rewritten as NumPy writes `np.asfortranarray` arrays: every `(n, 3)` array in
+    /// column-major order, marked `fortran_order: True`.
+    fn to_fortran(path: &Path) {
+        let (block, _) = read_shard(path).unwrap();
+        let header: Vec<u8> = NpzArchive::open(path)
+            .unwrap()
+            .by_name("header")
+            .unwrap()
+            .unwrap()
+            .into_vec()
+            .unwrap();
+        fn columns<T: npyz::AutoSerialize + Copy, W: Write + Seek>(
+            npz: &mut NpzWriter<W>,
+            name: &str,
+            rows: &[[T; 3]],
+        ) {
+            let stored = npyz::zip::write::FileOptions::default()
+                .compression_method(npyz::zip::CompressionMethod::Stored);
+            let mut w = npz
+                .array::<T>(name, stored)
+                .unwrap()
+                .default_dtype()
+                .shape(&[rows.len() as u64, 3])
+                .order(npyz::Order::Fortran)
+                .begin_nd()
+                .unwrap();
+            w.extend((0..3).flat_map(|j| rows.iter().map(move |r| r[j])))
+                .unwrap();
+            w.finish().unwrap();
+        }
+        let mut npz = NpzWriter::create(path).unwrap();
+        put(&mut npz, "header", &[header.len()], &header).unwrap();
+        put(&mut npz, "keys", &[block.keys.len()], &block.keys).unwrap();
+        columns(&mut npz, "positions", &block.positions);
+        columns(&mut npz, "normals", &block.normals);
+        columns(&mut npz, "triangles", &block.triangles);
+        put(&mut npz, "cubes", &[block.cubes.len()], &block.cubes).unwrap();
+        npz.zip_writer().finish().unwrap();
+    }
+
+    /// Shards whose `(n, 3)` arrays are stored in Fortran order read as the same blocks and
+    /// merge into the same mesh as the C-order shards they were rewritten from.
+    #[test]
+    fn fortran_order_shards_merge_as_c_order_ones() {
+        let v = demo::torus(16);
+        let params = Params::new(v.iso);
+        let volume = Volume::new(&v.data, v.dims).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let mut manifest = Manifest::new(v.dims, &params);
+        for z in [0..7, 7..15] {
+            let cubes = [0..15, 0..15, z];
+            let block = extract_block(&volume, [0; 3], v.dims, cubes.clone(), &params).unwrap();
+            let entry = ShardEntry::new(ShardEntry::file_name(&cubes), cubes, &block);
+            write_shard(
+                &dir.path().join(&entry.file),
+                &block,
+                &Settings::from(&params),
+            )
+            .unwrap();
+            manifest.shards.push(entry);
+        }
+        let path = dir.path().join(MANIFEST_NAME);
+        manifest.write(&path).unwrap();
+        let (_, c_order) = merge(&path).unwrap();
+        assert!(c_order.triangles.len() > 100);
+        for entry in &manifest.shards {
+            let shard = dir.path().join(&entry.file);
+            let before = read_shard(&shard).unwrap();
+            to_fortran(&shard);
+            let raw = std::fs::read(&shard).unwrap();
+            assert!(raw.windows(21).any(|w| w == b"'fortran_order': True"));
+            assert_eq!(read_shard(&shard).unwrap(), before);
+        }
+        let (_, fortran) = merge(&path).unwrap();
+        assert_eq!(fortran, c_order);
     }
 }

@@ -228,3 +228,21 @@ fn read_array(
         payload::read_samples(reader, layout, false, progress).map_err(|e| Error::io(path, e))?;
     Ok(Grid::new(samples, dims, "NumPy"))
 }
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+
+    /// An `.npz` that is a FIFO is refused before it is opened, as an `.npy` one is: the zip
+    /// reader would otherwise wait for a writer forever.
+    #[test]
+    fn a_fifo_npz_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("v.npz");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: mkfifo reads a NUL-terminated path that lives for the call.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let e = read(&fifo, None, &crate::progress::Silent).unwrap_err();
+        assert!(e.to_string().contains("v.npz: is not a regular file"), "{e}");
+    }
+}
