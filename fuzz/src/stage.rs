@@ -186,6 +186,7 @@ impl Target {
                     let grid = read(path, &options, &Silent).map_err(|e| e.to_string())?;
                     assert!(grid.dims.iter().product::<usize>() == grid.len());
                 }
+            }
             Target::Shards => {
                 let (_, mesh) = sc_io::shard::merge(path).map_err(|e| e.to_string())?;
                 let n = mesh.positions.len();
