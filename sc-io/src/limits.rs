@@ -17,10 +17,13 @@ pub const THREE_COORDINATES: &str =
 pub fn threads(n: u64) -> Result<usize, String> {
     match usize::try_from(n) {
         Ok(n) if n <= MAX_THREADS => Ok(n),
-        _ => Err(format!(
-            "at most {MAX_THREADS} threads (0 uses every core), not {n}"
-        )),
+        _ => Err(too_many_threads(n)),
     }
+}
+
+/// Why `n` threads are refused, for a count of any size (Python's integers have no bound).
+pub fn too_many_threads(n: impl std::fmt::Display) -> String {
+    format!("at most {MAX_THREADS} threads (0 uses every core), not {n}")
 }
 
 /// Whether `v` can be a coordinate, a spacing or an origin component.
@@ -125,7 +128,13 @@ mod tests {
         for n in [MAX_THREADS as u64 + 1, 1 << 31, u64::MAX] {
             let e = threads(n).unwrap_err();
             assert!(e.contains("at most 1024 threads"), "{e}");
+            assert!(e.ends_with(&format!("not {n}")), "{e}");
         }
+        let huge = too_many_threads("1267650600228229401496703205376");
+        assert!(
+            huge.ends_with("not 1267650600228229401496703205376"),
+            "{huge}"
+        );
     }
 
     #[test]

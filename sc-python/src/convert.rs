@@ -60,6 +60,15 @@ pub fn dims(array: &Bound<'_, PyUntypedArray>, name: &str) -> PyResult<[usize; 3
             shape.len()
         ))
     })?;
+    // A contiguous array at an odd byte offset (a view into a byte buffer) cannot be read as
+    // its type in place; the Python layer copies it first.
+    let aligned = array.getattr("flags")?.getattr("aligned")?.is_truthy()?;
+    if !aligned {
+        return Err(PyValueError::new_err(format!(
+            "{name}: the array is not aligned to its dtype; pass {name}.copy() \
+             (skelclimb.extract does this for you, with one copy)"
+        )));
+    }
     if array.is_c_contiguous() {
         Ok([c, b, a])
     } else if array.is_fortran_contiguous() {

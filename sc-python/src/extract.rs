@@ -7,6 +7,7 @@ use pyo3::types::PyDict;
 use sc_io::space::{Space, World};
 use sc_runtime::{ErrorBound, Figure, Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
 
+use crate::arguments;
 use crate::convert::{self, with_element};
 use crate::errors;
 use crate::world;
@@ -47,16 +48,13 @@ pub fn params(
             "level: must be a finite number, got {level}"
         )));
     }
-    if !spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
+    let spacing = arguments::triple("spacing", spacing)?;
+    if !spacing.iter().all(|s| *s > 0.0) {
         return Err(PyValueError::new_err(format!(
-            "spacing: must be three positive finite numbers, got {spacing:?}"
+            "spacing: must be three positive numbers, got {spacing:?}"
         )));
     }
-    if !origin.iter().all(|o| o.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "origin: must be three finite numbers, got {origin:?}"
-        )));
-    }
+    let origin = arguments::triple("origin", origin)?;
     Ok(Params {
         mode: mode(mode_name)?,
         max_error: bound(max_error)?,
@@ -82,11 +80,12 @@ pub fn extract<'py>(
     origin: [f64; 3],
     mode: &str,
     normals: bool,
-    threads: usize,
+    threads: &Bound<'py, PyAny>,
     max_error: Option<(f64, String)>,
     affine: Option<[[f64; 4]; 3]>,
     space: Option<&str>,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    let threads = arguments::threads(threads)?;
     let space = world::space(space)?;
     let (spacing, world) = match affine {
         Some(rows) => world::from_affine(rows, space)?,

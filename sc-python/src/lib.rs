@@ -2,6 +2,7 @@
 //! copies, the GIL released while the Rust extractor runs, errors as Python exceptions. The
 //! NumPy-facing conveniences (`marching_cubes`, `Mesh`) are Python, in `python/skelclimb`.
 
+mod arguments;
 mod blocks;
 mod convert;
 mod errors;
@@ -38,6 +39,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shards::write_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(shards::merge_shards, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(arguments::check_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(arguments::check_triple, m)?)?;
+    m.add_function(wrap_pyfunction!(arguments::check_affine, m)?)?;
     m.add_class::<streamer::SliceStreamer>()?;
     // The modes' names from the runtime's table, which every front end spells them by.
     m.add("MODES", sc_runtime::Mode::NAMES)?;

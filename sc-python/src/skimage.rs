@@ -8,6 +8,7 @@ use numpy::{PyArray1, PyUntypedArray};
 use pyo3::prelude::*;
 use sc_runtime::{Axes, Mesh, Mode, Params};
 
+use crate::arguments;
 use crate::convert::{self, with_element};
 use crate::extract::run;
 
@@ -24,15 +25,16 @@ pub fn skimage_mesh<'py>(
     volume: &Bound<'py, PyUntypedArray>,
     level: f64,
     spacing: [f64; 3],
-    threads: usize,
+    threads: &Bound<'py, PyAny>,
     reverse_axes: bool,
     flip_winding: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    let threads = arguments::threads(threads)?;
     let params = Params {
         mode: Mode::Embedded,
         normals: true,
         values: true,
-        spacing,
+        spacing: arguments::triple("spacing", spacing)?,
         axes: if reverse_axes { Axes::Zyx } else { Axes::Xyz },
         ..Params::new(level)
     };

@@ -11,7 +11,7 @@ use std::sync::mpsc::{SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use sc_runtime::{Mesh, Scratch, SliceStreamer as Streamer, Stats};
@@ -47,12 +47,20 @@ impl SliceStreamer {
         let [nz, ny, nx] = shape;
         let dims = [nx, ny, nz];
         let len = Scratch::len(dims).map_err(errors::runtime)?;
+        // The ring of four slices and the scratch are allocated here, where a size the process
+        // cannot hold is a `MemoryError` (NumPy's word for it) and not an abort on the worker.
+        let ring_len = 4u128 * nx as u128 * ny as u128;
+        let need = ring_len * 8 + len.bytes as u128 + len.words as u128 * 4;
+        let what = format!("shape: streaming a volume of shape ({nz}, {ny}, {nx})");
+        sc_io::limits::bytes(need, 1, &what).map_err(PyMemoryError::new_err)?;
+        let too_big = || PyMemoryError::new_err(format!("{what} failed to allocate its buffers"));
+        let mut bytes = zeroed::<u8>(len.bytes).ok_or_else(too_big)?;
+        let mut words = zeroed::<u32>(len.words).ok_or_else(too_big)?;
+        let mut ring = zeroed::<f64>(ring_len as usize).ok_or_else(too_big)?;
         let (sender, slices) = sync_channel::<Vec<f64>>(2);
         let worker = std::thread::Builder::new()
             .name("skelclimb-streamer".into())
             .spawn(move || {
-                let (mut bytes, mut words) = (vec![0u8; len.bytes], vec![0u32; len.words]);
-                let mut ring = vec![0f64; Streamer::<f64, Mesh>::ring_len(dims)];
                 let scratch = Scratch::new(&mut bytes, &mut words, dims)?;
                 let mut s = Streamer::new(dims, &params, scratch, &mut ring, Mesh::default())?;
                 for slice in slices {
@@ -111,6 +119,14 @@ impl SliceStreamer {
         )
             .into_pyobject(py)
     }
+}
+
+/// `n` zeros, or `None` when the allocation fails.
+fn zeroed<T: Clone + Default>(n: usize) -> Option<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).ok()?;
+    v.resize(n, T::default());
+    Some(v)
 }
 
 impl SliceStreamer {

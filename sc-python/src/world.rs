@@ -31,6 +31,7 @@ pub fn space(name: Option<&str>) -> PyResult<Option<Space>> {
 /// their directions and the last column the map [`World::place`] applies afterwards, exactly as
 /// for a file read by the CLI. Refuses what no placement can be built from.
 pub fn from_affine(rows: [[f64; 4]; 3], space: Option<Space>) -> PyResult<([f64; 3], World)> {
+    crate::arguments::affine(&rows)?;
     let columns = [0, 1, 2].map(|c| rows.map(|r| r[c]));
     let offset = rows.map(|r| r[3]);
     let frame = Frame::from_columns(columns, space.unwrap_or(Space::Ras))

@@ -19,6 +19,7 @@ Two entry points:
 
 from __future__ import annotations
 
+import operator
 from typing import NamedTuple, Optional
 
 import numpy as np
@@ -115,14 +116,37 @@ class Mesh:
         return poly
 
 
-def _triple(value, name):
+def _real(value, name):
+    """``value`` as a float. A string is refused, though ``float`` would read it: a number
+    written as text is a mistake NumPy does not make silently either."""
+    if isinstance(value, (str, bytes, bytearray)):
+        raise TypeError(f"{name}: expected a number, got {value!r}")
     try:
-        items = tuple(float(v) for v in value)
+        return float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected a number, got {value!r}") from None
+
+
+def _index(value, name):
+    """``value`` as an int, as ``operator.index`` reads it: ``1.5`` is a TypeError, NumPy
+    integers are fine."""
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name}: expected a whole number, got {value!r}") from None
+
+
+def _triple(value, name):
+    """Three floats, finite and below the command's limit (``_native.triple``)."""
+    if isinstance(value, (str, bytes, bytearray)):
+        raise TypeError(f"{name}: expected three numbers, got {value!r}")
+    try:
+        items = tuple(_real(v, name) for v in value)
     except TypeError:
         raise TypeError(f"{name}: expected three numbers, got {value!r}") from None
     if len(items) != 3:
         raise ValueError(f"{name}: expected three numbers, got {len(items)}")
-    return items
+    return _native.triple(items, name)
 
 
 def _volume(volume, name="volume"):
@@ -137,14 +161,14 @@ def _volume(volume, name="volume"):
         volume = volume.astype(volume.dtype.newbyteorder("="))
     if not (volume.flags.c_contiguous or volume.flags.f_contiguous):
         volume = np.ascontiguousarray(volume)
+    elif not volume.flags.aligned:
+        # A contiguous view at an odd byte offset: the copy keeps its order and is aligned.
+        volume = volume.copy(order="K")
     return volume
 
 
 def _level(level):
-    try:
-        level = float(level)
-    except (TypeError, ValueError):
-        raise TypeError(f"level: expected a number, got {level!r}") from None
+    level = _real(level, "level")
     if not np.isfinite(level):
         raise ValueError(f"level: must be finite, got {level}")
     return level
@@ -182,7 +206,8 @@ def _pad(volume, level):
             raise ValueError(f"pad: no {volume.dtype} value is below level {level}")
         fill = volume.dtype.type(min(below, info.max))
     else:
-        fill = volume.dtype.type(level)
+        with np.errstate(over="ignore"):  # a level beyond the type's range rounds to inf
+            fill = volume.dtype.type(level)
         if not fill < level:
             fill = np.nextafter(fill, volume.dtype.type(-np.inf))
     order = "F" if volume.flags.f_contiguous and not volume.flags.c_contiguous else "C"
@@ -200,8 +225,7 @@ def _affine(affine, spacing, origin):
         raise TypeError(f"affine: expected a 4×4 array of numbers, got {affine!r}") from None
     if affine.shape != (4, 4):
         raise ValueError(f"affine: expected a 4×4 array, got shape {affine.shape}")
-    if not np.isfinite(affine).all():
-        raise ValueError(f"affine: must be finite, got\n{affine}")
+    _native.affine(affine[:3].tolist())
     if not np.array_equal(affine[3], [0, 0, 0, 1]):
         raise ValueError(f"affine: the last row must be (0, 0, 0, 1), got {affine[3]}")
     # A spacing or origin beside the affine is allowed only if it says the same.
@@ -311,9 +335,7 @@ def extract(
     origin = _triple((0, 0, 0) if origin is None else origin, "origin")
     if mode not in _MODES:
         raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
-    threads = int(threads)
-    if threads < 0:
-        raise ValueError(f"threads: must be 0 (all cores) or more, got {threads}")
+    threads = _native.threads(threads)
     if pad:
         volume, order = _pad(volume, level)
         volume = np.asarray(volume, order=order)
@@ -381,7 +403,7 @@ def load(path, **options):
     >>> mesh = skelclimb.extract(volume, 300, affine=affine, space=space)  # doctest: +SKIP
     """
     if "dims" in options and options["dims"] is not None:
-        options["dims"] = tuple(int(d) for d in options["dims"])
+        options["dims"] = tuple(_index(d, "dims") for d in options["dims"])
     return Scan(*_native.load(str(path), **options))
 
 
@@ -400,9 +422,11 @@ class SliceStreamer:
 
     def __init__(self, shape, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded",
                  normals=True):
-        shape = tuple(int(n) for n in shape)
+        shape = tuple(_index(n, "shape") for n in shape)
         if len(shape) != 3 or min(shape) < 0:
             raise ValueError(f"shape: expected (nz, ny, nx), got {shape!r}")
+        if max(shape) >= 2**64:
+            raise MemoryError(f"shape: streaming a volume of shape {shape} is beyond any memory")
         if mode not in _MODES:
             raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
         self._native = _native.SliceStreamer(
@@ -415,7 +439,7 @@ class SliceStreamer:
         slice = np.asarray(slice)
         if slice.ndim != 2:
             raise ValueError(f"slice: expected a 2-D array, got {slice.ndim} dimensions")
-        self._native.push(np.ascontiguousarray(slice, dtype=np.float64))
+        self._native.push(np.require(slice, np.float64, ["C_CONTIGUOUS", "ALIGNED"]))
 
     def finish(self):
         """Finishes after all ``nz`` slices and returns the :class:`Mesh`."""
@@ -439,7 +463,7 @@ def merge_shards(manifest):
     """
     import os
 
-    verts, faces, norms, stats = _native.merge_shards(os.fspath(manifest))
+    verts, faces, norms, stats = _native.merge_shards(os.fsdecode(manifest))
     return Mesh(verts, faces, norms, stats)
 
 

@@ -49,7 +49,7 @@ def marching_cubes(
     step_size: int = ...,
     allow_degenerate: bool = ...,
     method: Literal["lewiner", "lorensen"] = ...,
-    mask: Optional[npt.NDArray[np.bool_]] = ...,
+    mask: Optional[npt.NDArray[Any]] = ...,
     threads: int = ...,
 ) -> Tuple[
     npt.NDArray[np.float32],

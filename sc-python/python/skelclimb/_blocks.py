@@ -99,17 +99,19 @@ def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=
     >>> bool((joined.vertices == whole.vertices).all() and (joined.faces == whole.faces).all())
     True
     """
-    from . import _MODES, _bound, _level, _triple, _volume
+    from . import _MODES, _bound, _index, _level, _triple, _volume
 
     samples = _volume(samples, "samples")
     level = _level(level)
     if mode not in _MODES:
         raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
-    at = tuple(int(a) for a in at)
-    grid = tuple(int(n) for n in grid)
-    cubes = tuple((int(a), int(b)) for a, b in cubes)
+    at = tuple(_index(a, "at") for a in at)
+    grid = tuple(_index(n, "grid") for n in grid)
+    cubes = tuple((_index(a, "cubes"), _index(b, "cubes")) for a, b in cubes)
     if len(at) != 3 or len(grid) != 3 or len(cubes) != 3:
         raise ValueError("at, grid and cubes: expected three entries each (x, y, z)")
+    if min(at + grid + sum(cubes, ())) < 0:
+        raise ValueError(f"at, grid and cubes: must not be negative, got {at}, {grid}, {cubes}")
     share = _native.extract_block(
         samples, at, grid, cubes, level, _triple(spacing, "spacing"), _triple(origin, "origin"),
         mode, bool(normals), _bound(max_error, error_units),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _native, _triple, _volume
+from . import _index, _level, _native, _triple, _volume
 
 _METHODS = ("lewiner", "lorensen")
 
@@ -55,7 +55,7 @@ def marching_cubes(
     method : ``'lewiner'`` or ``'lorensen'``
         Checked, otherwise ignored: the surface is always Skeleton Climbing's.
     mask : (M, N, P) bool ndarray, optional
-        Keep only triangles in cubes whose upper corner (the largest index along every axis) is
+        A numeric mask is read as ``mask != 0``. Keep only triangles in cubes whose upper corner (the largest index along every axis) is
         True, as scikit-image does. A merged triangle spans two cubes and is kept when the cube
         holding its centroid is.
     threads : int
@@ -84,13 +84,20 @@ def marching_cubes(
     spacing = _triple(spacing, "spacing")
     if not all(np.isfinite(s) and s > 0 for s in spacing):
         raise ValueError(f"spacing: must be three positive numbers, got {spacing}")
-    step_size = int(step_size)
+    step_size = _index(step_size, "step_size")
     if step_size < 1:
         raise ValueError("step_size must be at least one.")
+    threads = _native.threads(threads)
     if mask is not None:
         mask = np.asarray(mask)
         if mask.shape != volume.shape:
             raise ValueError("volume and mask must have the same shape.")
+        if mask.dtype != np.bool_:
+            # A mask of numbers is a truth value per sample, as NumPy reads it (``mask != 0``),
+            # not a list of indices.
+            if not np.issubdtype(mask.dtype, np.number):
+                raise TypeError(f"mask: expected a bool or numeric array, got dtype {mask.dtype}")
+            mask = mask != 0
 
     if volume.dtype == np.bool_:
         volume = volume.view(np.uint8)
@@ -105,9 +112,7 @@ def marching_cubes(
     if level is None:
         level = 0.5 * (float(volume.min()) + float(volume.max()))
     else:
-        level = float(level)
-        if not np.isfinite(level):
-            raise ValueError(f"level: must be finite, got {level}")
+        level = _level(level)
 
     # The native call works in (x, y, z) with x fastest in memory: the array's axes reversed
     # for a C-ordered array, as they are for a Fortran-ordered one. Ours wind outward from
@@ -121,7 +126,7 @@ def marching_cubes(
     xyz_spacing = tuple(spacing[a] * step_size for a in axes)
     flip = c_order != (gradient_direction == "descent")
     verts, faces, normals, values = _native.skimage_mesh(
-        volume, level, xyz_spacing, int(threads), c_order, flip
+        volume, level, xyz_spacing, threads, c_order, flip
     )
     faces = faces.view(np.int32)  # uint32 indices below 2**31: the same bits, no copy
     if len(faces) == 0:

@@ -135,8 +135,8 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
 
     Parameters
     ----------
-    array : dask.array.Array
-        Axes ``(z, y, x)`` as for a C-ordered array in :func:`skelclimb.extract` (so
+    array : dask.array.Array or numpy.ndarray
+        A NumPy array is wrapped with ``dask.array.from_array`` (automatic chunks). Axes ``(z, y, x)`` as for a C-ordered array in :func:`skelclimb.extract` (so
         ``dask.array.from_zarr`` of a ZYX store works as it is). One task per chunk; chunks of
         64³–256³ samples balance task overhead against memory per task.
     level, spacing, origin, mode, normals, max_error, error_units
@@ -176,15 +176,16 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     from dask.delayed import Delayed
     from dask.highlevelgraph import HighLevelGraph, MaterializedLayer
 
-    from . import _MODES, _bound, _level, _triple
+    from . import _MODES, _bound, _index, _level, _triple
 
+    array = _dask_array(array)
     level = _level(level)
     spacing, origin = _triple(spacing, "spacing"), _triple(origin, "origin")
     if mode not in _MODES:
         raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
     if array.ndim != 3:
         raise ValueError(f"array: expected 3 dimensions, got {array.ndim}")
-    split_every = int(split_every)
+    split_every = _index(split_every, "split_every")
     if split_every < 2:
         raise ValueError(f"split_every: must be at least 2, got {split_every}")
     nz, ny, nx = array.shape
@@ -268,6 +269,22 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     # The last merge runs here, where the mesh is wanted anyway, so that no worker has to hold
     # the whole mesh (and its inputs) on top of its chunks.
     return _finish(_merge(*dask.compute(*results)))
+
+
+def _dask_array(array):
+    """``array`` as a ``dask.array`` with known chunk sizes: a NumPy array (or anything with
+    ``__array__``) is wrapped in one, with Dask's automatic chunks."""
+    import dask.array as da
+
+    if not isinstance(array, da.Array):
+        if not (isinstance(array, np.ndarray) or hasattr(array, "__array__")):
+            raise TypeError(f"array: expected a dask.array or a NumPy array, got "
+                            f"{type(array).__name__}")
+        array = da.from_array(array)
+    if any(np.isnan(c) for axis in array.chunks for c in axis):
+        raise ValueError("array: its chunk sizes are unknown (NaN), as after boolean indexing; "
+                         "call array.compute_chunk_sizes() first")
+    return array
 
 
 def _by_z_layer(key):
