@@ -9,8 +9,9 @@
 # Installs cargo-afl if it is missing and builds AFL++ once (cargo afl config --build), builds the
 # instrumented target (src/main.rs; again with sc-io's `zarr` feature for the Zarr target), then
 # runs one afl-fuzz at a time (one core) on each reader, starting from fuzz/corpus/<target>.
-# AFL's findings go to fuzz/out/<target>/default/{crashes,hangs}; the script fails if any target has one. A finding becomes a file in fuzz/regressions/<target>/
-# (replayed by `cargo test -p sc-io --test fuzz_corpus`) and a fix in sc-io.
+# AFL's findings go to fuzz/out/<target>/default/{crashes,hangs}; the script fails if any target
+# has one. A finding becomes a file in fuzz/regressions/<target>/ (replayed by `cargo test -p
+# sc-io --test fuzz_corpus`) and a fix in sc-io.
 #
 # Limits per input: 2 s (a hang beyond that is a finding) and 1 GiB of address space (a reader
 # that allocates past what a small file declares aborts, which is a finding too).
