@@ -249,6 +249,13 @@ fn shards(dir: &Path, data: &[u8]) -> std::io::Result<PathBuf> {
             Some(piece)
         })
     }
+    // A folder of its own, emptied for each input: a shard left by an earlier input would
+    // otherwise stand in for one this input lacks.
+    let dir = dir.join("shards");
+    match std::fs::remove_dir_all(&dir) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+        _ => std::fs::create_dir(&dir)?,
+    }
     let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let manifest = dir.join("manifest.json");
     std::fs::write(&manifest, &data[..split])?;

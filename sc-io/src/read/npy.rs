@@ -243,6 +243,9 @@ mod tests {
         // SAFETY: mkfifo reads a NUL-terminated path that lives for the call.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         let e = read(&fifo, None, &crate::progress::Silent).unwrap_err();
-        assert!(e.to_string().contains("v.npz: is not a regular file"), "{e}");
+        assert!(
+            e.to_string().contains("v.npz: is not a regular file"),
+            "{e}"
+        );
     }
 }
