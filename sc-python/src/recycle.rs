@@ -3,9 +3,8 @@
 //! A mesh's arrays are handed to NumPy without a copy, so NumPy frees them when the user drops
 //! them, through this crate's global allocator. Blocks of tens of megabytes are mapped fresh by
 //! glibc for every call and unmapped on free, and the kernel zeroes each page again when the next
-//! call first writes it: with each call's arrays dropped before the next, the noisy sphere at
-//! 256³ (2.7 M triangles, about 70 MB of arrays) took 64–66 ms a call, 54–55 ms with that memory
-//! kept (docs/speed-log.md). So blocks of [`LARGE`] bytes and more that are freed here wait in a
+//! call first writes it, a sixth of a large mesh's call (docs/speed-log.md has the figures). So
+//! blocks of [`LARGE`] bytes and more that are freed here wait in a
 //! small cache, up to [`CAP`] bytes, and the next allocation they fit takes one instead of asking
 //! for fresh pages. [`release`] (`skelclimb.release_memory()`) gives them back at once.
 //!

@@ -200,8 +200,8 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     # (read, shell, mesh) where dask.array.overlap makes some 24, and every chunk read once.
     array = array.rechunk(tuple(_at_least(c, _AFTER) for c in array.chunks))
     # The graph is written out here, task by task, rather than by calling dask.delayed
-    # functions: each such call merges and culls its arguments' graphs, which took 1.75 s for
-    # the 2,635 tasks of a 1024³ array in 128³ chunks.
+    # functions: each such call merges and culls its arguments' graphs, which grows with the
+    # number of tasks and dominates a large array's graph building.
     keys = array.__dask_keys__()
     shape = tuple(len(c) for c in array.chunks)
     chunks = {idx: keys[idx[0]][idx[1]][idx[2]] for idx in np.ndindex(shape)}
