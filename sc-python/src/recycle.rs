@@ -4,9 +4,9 @@
 //! them, through this crate's global allocator. Blocks of tens of megabytes are mapped fresh by
 //! glibc for every call and unmapped on free, and the kernel zeroes each page again when the next
 //! call first writes it, a sixth of a large mesh's call (docs/speed-log.md has the figures). So
-//! blocks of [`LARGE`] bytes and more that are freed here wait in a
-//! small cache, up to [`CAP`] bytes, and the next allocation they fit takes one instead of asking
-//! for fresh pages. [`release`] (`skelclimb.release_memory()`) gives them back at once.
+//! blocks of [`LARGE`] bytes and more that are freed here wait in a small cache, up to [`CAP`]
+//! bytes, and the next allocation they fit takes one instead of asking for fresh pages.
+//! [`release`] (`skelclimb.release_memory()`) gives them back at once.
 //!
 //! Every block comes from C's `malloc`, whose `free` and `realloc` need no size: a cached block
 //! handed out for a smaller request is freed or resized correctly whatever layout it is later
