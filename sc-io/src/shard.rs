@@ -330,22 +330,26 @@ impl Manifest {
                 }
             }
         }
-        let mut by_start: Vec<&ShardEntry> = self.shards.iter().filter(|s| s.count() > 0).collect();
-        by_start.sort_by_key(|s| s.cubes[2].start);
-        for (i, a) in by_start.iter().enumerate() {
-            for b in &by_start[i + 1..] {
-                if b.cubes[2].start >= a.cubes[2].end {
-                    break;
-                }
-                if (0..3).all(|d| overlap(&a.cubes[d], &b.cubes[d])) {
-                    let both: [Range<usize>; 3] = std::array::from_fn(|d| {
-                        a.cubes[d].start.max(b.cubes[d].start)..a.cubes[d].end.min(b.cubes[d].end)
-                    });
-                    return refuse(format!(
-                        "shards {} and {} both own the cubes {both:?} (x, y, z)",
-                        a.file, b.file
-                    ));
-                }
+        let boxes: Vec<&ShardEntry> = self.shards.iter().filter(|s| s.count() > 0).collect();
+        // Sixteen cells a box: a grid of blocks has one.
+        let cell_budget = (16 * boxes.len() as u64).max(1 << 20);
+        match overlapping(&boxes, (cell_budget, PAIR_BUDGET)) {
+            Ok(None) => {}
+            Ok(Some((a, b))) => {
+                let both: [Range<usize>; 3] = std::array::from_fn(|d| {
+                    a.cubes[d].start.max(b.cubes[d].start)..a.cubes[d].end.min(b.cubes[d].end)
+                });
+                return refuse(format!(
+                    "shards {} and {} both own the cubes {both:?} (x, y, z)",
+                    a.file, b.file
+                ));
+            }
+            Err(()) => {
+                return refuse(format!(
+                    "its {} shards' boxes are too irregular to check for overlaps: shards are \
+                     blocks of a grid of blocks",
+                    boxes.len()
+                ));
             }
         }
         // Disjoint boxes inside the grid: their counts sum to at most `total`.
@@ -361,6 +365,73 @@ impl Manifest {
 
 /// Axis names for messages.
 const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Pairs of boxes that [`overlapping`] may compare when it cannot mark cells.
+const PAIR_BUDGET: u64 = 1 << 26;
+
+/// Two boxes that share a cube, if any. The boxes' boundaries cut the grid into a coarse grid
+/// whose cells each lie in one box or none: a grid of blocks has as many cells as blocks, and
+/// marking each box's cells finds a shared one in time and memory proportional to the cells.
+/// Boundaries that make more than `cell_budget` cells (irregular boxes, which no tool writes)
+/// fall back to comparing the pairs whose z ranges meet, up to `pair_budget` pairs; beyond that,
+/// `Err`, so that a hostile manifest cannot keep the merge busy for hours.
+fn overlapping<'s>(
+    boxes: &[&'s ShardEntry],
+    (cell_budget, pair_budget): (u64, u64),
+) -> std::result::Result<Option<(&'s ShardEntry, &'s ShardEntry)>, ()> {
+    let cuts: [Vec<usize>; 3] = std::array::from_fn(|d| {
+        let mut c: Vec<usize> = boxes
+            .iter()
+            .flat_map(|b| [b.cubes[d].start, b.cubes[d].end])
+            .collect();
+        c.sort_unstable();
+        c.dedup();
+        c
+    });
+    let cells = cuts
+        .iter()
+        .try_fold(1u64, |n, c| n.checked_mul(c.len().saturating_sub(1) as u64));
+    if let Some(cells) = cells.filter(|&n| n <= cell_budget) {
+        let [nx, ny] = [cuts[0].len() - 1, cuts[1].len() - 1];
+        let mut owner = vec![u32::MAX; cells as usize];
+        for (i, b) in boxes.iter().enumerate() {
+            let span = |d: usize| {
+                let at = |v: usize| cuts[d].partition_point(|&c| c < v);
+                at(b.cubes[d].start)..at(b.cubes[d].end)
+            };
+            for z in span(2) {
+                for y in span(1) {
+                    for x in span(0) {
+                        let cell = &mut owner[x + nx * (y + ny * z)];
+                        if *cell != u32::MAX {
+                            return Ok(Some((boxes[*cell as usize], b)));
+                        }
+                        *cell = i as u32;
+                    }
+                }
+            }
+        }
+        return Ok(None);
+    }
+    let mut by_start = boxes.to_vec();
+    by_start.sort_by_key(|s| s.cubes[2].start);
+    let mut pairs = 0u64;
+    for (i, a) in by_start.iter().enumerate() {
+        for b in &by_start[i + 1..] {
+            if b.cubes[2].start >= a.cubes[2].end {
+                break;
+            }
+            pairs += 1;
+            if pairs > pair_budget {
+                return Err(());
+            }
+            if (0..3).all(|d| overlap(&a.cubes[d], &b.cubes[d])) {
+                return Ok(Some((a, b)));
+            }
+        }
+    }
+    Ok(None)
+}
 
 fn overlap(a: &Range<usize>, b: &Range<usize>) -> bool {
     a.start < b.end && b.start < a.end
@@ -762,6 +833,50 @@ mod tests {
 
     /// Shards whose `(n, 3)` arrays are stored in Fortran order read as the same blocks and
     /// merge into the same mesh as the C-order shards they were rewritten from.
+    /// Every pair of boxes in a 3 × 3 × 3 grid of cubes, found overlapping by marking cells and by
+    /// comparing pairs exactly when they share a cube; a grid of 200,000 one-cube blocks in one
+    /// layer has none; and pairs beyond the budget are refused rather than compared.
+    #[test]
+    fn overlaps_are_found_by_both_paths_exactly() {
+        let ranges: Vec<Range<usize>> = (0..3)
+            .flat_map(|a| (a + 1..=3).map(move |b| a..b))
+            .collect();
+        let boxes: Vec<ShardEntry> = (0..ranges.len().pow(3))
+            .map(|i| {
+                let n = ranges.len();
+                let cubes = [i % n, i / n % n, i / (n * n)].map(|k| ranges[k].clone());
+                ShardEntry::new(format!("b{i}.npz"), cubes, &BlockMesh::default())
+            })
+            .collect();
+        for a in &boxes {
+            for b in &boxes {
+                if std::ptr::eq(a, b) {
+                    continue;
+                }
+                let shared = (0..3).all(|d| overlap(&a.cubes[d], &b.cubes[d]));
+                for budgets in [(u64::MAX, u64::MAX), (0, u64::MAX)] {
+                    let found = overlapping(&[a, b], budgets).unwrap();
+                    assert_eq!(
+                        found.is_some(),
+                        shared,
+                        "{:?} {:?} {budgets:?}",
+                        a.cubes,
+                        b.cubes
+                    );
+                }
+            }
+        }
+        let blocks: Vec<ShardEntry> = (0..200_000)
+            .map(|i| {
+                let cubes = [i % 1000..i % 1000 + 1, i / 1000..i / 1000 + 1, 0..1];
+                ShardEntry::new(format!("b{i}.npz"), cubes, &BlockMesh::default())
+            })
+            .collect();
+        let refs: Vec<&ShardEntry> = blocks.iter().collect();
+        assert!(overlapping(&refs, (16 * 200_000, 0)).unwrap().is_none());
+        assert!(overlapping(&refs[..100], (0, 10)).is_err());
+    }
+
     #[test]
     fn fortran_order_shards_merge_as_c_order_ones() {
         let v = demo::torus(16);
