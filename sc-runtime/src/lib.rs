@@ -42,6 +42,14 @@ pub use drivers::reuse::{Extractor, extract};
 #[cfg(feature = "alloc")]
 pub use mesh::Mesh;
 
+/// Label volumes: every region of a segmentation meshed in one sweep (docs/labels.md). The
+/// cube constructions are `no_std`; [`labels::extract_labels`] needs `alloc`.
+pub mod labels {
+    #[cfg(feature = "alloc")]
+    pub use crate::drivers::labels::{Atlas, Label, LabelParams, extract_labels};
+    pub use crate::kernel::labels::*;
+}
+
 #[cfg(feature = "std")]
 pub mod demo;
 #[cfg(feature = "std")]

@@ -18,6 +18,8 @@ pub(crate) mod stream;
 #[cfg(feature = "alloc")]
 pub(crate) mod blocks;
 #[cfg(feature = "alloc")]
+pub(crate) mod labels;
+#[cfg(feature = "alloc")]
 pub(crate) mod reuse;
 #[cfg(feature = "alloc")]
 pub(crate) mod survey;

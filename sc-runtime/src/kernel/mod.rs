@@ -7,6 +7,7 @@
 pub(crate) mod engine;
 pub(crate) mod error;
 pub mod geometry;
+pub mod labels;
 pub(crate) mod params;
 pub(crate) mod prefetch;
 pub(crate) mod scalar;

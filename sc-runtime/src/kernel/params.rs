@@ -1,4 +1,4 @@
-use crate::{Error, Scalar};
+use crate::Error;
 
 /// `Display` and `FromStr` for a type with a table of names, `NAMES`, in the order of `ALL`:
 /// each value is written as its name, and parsed from exactly that name.
@@ -216,7 +216,7 @@ pub struct Volume<'a, T> {
     dims: [usize; 3],
 }
 
-impl<'a, T: Scalar> Volume<'a, T> {
+impl<'a, T> Volume<'a, T> {
     /// Checks that `data` holds exactly `nx · ny · nz` samples.
     pub fn new(data: &'a [T], dims: [usize; 3]) -> Result<Self, Error> {
         let expected = dims

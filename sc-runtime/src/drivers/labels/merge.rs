@@ -1,0 +1,150 @@
+//! Step 4 on a label volume: a grey edge is merged as the binary engine would merge it, and only
+//! where the binary engine's promises carry over.
+//!
+//! The four cubes around the edge must be binary cubes with the same background label `W`, so
+//! their ears are the ones the binary engine makes of the indicator "label ≠ `W`". In embedded
+//! mode, the edge must also pass SPEC §5 (a) and (b) on that indicator, and every sample (b)
+//! reads must be `W` or the edge's other label, so that the merge decision sees a two-label
+//! neighbourhood, as in the binary volumes the rules were checked on. The merged pair stays in
+//! the box of the four cubes and meets its faces only at vertices, so it cannot cross another
+//! cube's triangles.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::sweep::{Ear, Padded};
+use super::{Atlas, Label, LabelParams};
+use crate::{Mode, Volume};
+
+/// Merges what may merge among `ears`, then drops the vertices and triangles merged away.
+pub(super) fn merge<L: Label>(
+    volume: Volume<'_, L>,
+    params: &LabelParams<L>,
+    mut ears: Vec<Ear<L>>,
+    atlas: &mut Atlas<L>,
+) {
+    if ears.is_empty() {
+        return;
+    }
+    let grid = Padded::new(volume, params);
+    ears.sort_unstable_by_key(|e| e.vertex);
+    let mut gone_vertex = vec![false; atlas.positions.len()];
+    let mut gone_triangle = vec![false; atlas.triangles.len()];
+    for group in ears.chunk_by(|a, b| a.vertex == b.vertex) {
+        // Fewer than four ears: a cube around the edge is not binary, or lies outside the grid.
+        let [a, b, c, d] = group else { continue };
+        let w = a.background;
+        let allowed = [b, c, d].iter().all(|e| e.background == w)
+            && (params.mode == Mode::Paper
+                || group.iter().all(|e| e.mergeable) && !blocks(&grid, a.lower, a.axis, w));
+        let pair = allowed.then(|| quad(atlas, [a, b, c, d])).flatten();
+        let Some([first, second]) = pair else {
+            atlas.stats.blocked += 1;
+            continue;
+        };
+        atlas.triangles[a.triangle as usize] = first;
+        atlas.triangles[b.triangle as usize] = second;
+        gone_triangle[c.triangle as usize] = true;
+        gone_triangle[d.triangle as usize] = true;
+        gone_vertex[a.vertex as usize] = true;
+        atlas.stats.merged += 1;
+    }
+    compact(atlas, &gone_vertex, &gone_triangle);
+}
+
+/// The two triangles replacing the four ears `[back, grey, forward]` around a grey vertex, split
+/// along the diagonal whose corners the ears mark; `None` if the ears do not close a fan.
+fn quad<L>(atlas: &Atlas<L>, ears: [&Ear<L>; 4]) -> Option<[[u32; 3]; 2]> {
+    let t = ears.map(|e| atlas.triangles[e.triangle as usize]);
+    // Around the grey vertex the fan runs forward → back: q0 = forward of the first ear.
+    let mut q = [0u32; 4];
+    let mut marked = [false; 4];
+    let mut ear = 0;
+    q[0] = t[0][2];
+    marked[0] = ears[0].diagonal & 2 != 0;
+    for k in 1..4 {
+        q[k] = t[ear][0];
+        marked[k] = ears[ear].diagonal & 1 != 0;
+        ear = (0..4).find(|&n| t[n][2] == q[k])?;
+    }
+    if t[ear][0] != q[0] {
+        return None;
+    }
+    match marked {
+        [true, false, true, false] => Some([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]),
+        [false, true, false, true] => Some([[q[1], q[2], q[3]], [q[1], q[3], q[0]]]),
+        _ => None,
+    }
+}
+
+/// Whether SPEC §5 (b) blocks the grey edge from `p` along `axis` on the indicator "label ≠
+/// `w`", or a sample it reads has a third label.
+fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> bool {
+    let mut up = p;
+    up[axis] += 1;
+    let x = if grid.at(p) == w {
+        grid.at(up)
+    } else {
+        grid.at(p)
+    };
+    let n = grid.n;
+    let inside = |a: usize| p[a] >= 1 && p[a] + 1 < n[a];
+    let at = |d: [isize; 3]| {
+        let q: [usize; 3] = core::array::from_fn(|a| p[a].wrapping_add_signed(d[a]));
+        (q.iter().zip(&n).all(|(&c, &m)| c < m)).then(|| grid.at(q))
+    };
+    let plane: [[isize; 3]; 9] =
+        core::array::from_fn(|i| [i as isize % 3 - 1, i as isize / 3 - 1, 0]);
+    let column = [[0, 0, -1], [0, 0, 1]];
+    let read = plane
+        .iter()
+        .chain(if axis == 2 { &column[..] } else { &[] });
+    if read
+        .clone()
+        .filter_map(|&d| at(d))
+        .any(|l| l != w && l != x)
+    {
+        return true;
+    }
+    if !(inside(0) && inside(1)) || axis == 2 && !inside(2) {
+        return false;
+    }
+    let filled = |d: [isize; 3]| at(d).is_some_and(|l| l != w);
+    let centre = filled([0, 0, 0]);
+    let faces = [[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0]]
+        .into_iter()
+        .all(|d| filled(d) != centre);
+    if axis == 2 {
+        faces && column.into_iter().all(|d| filled(d) != centre)
+    } else {
+        let corners = [[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]];
+        faces && (centre || corners.into_iter().all(filled))
+    }
+}
+
+/// Drops the marked vertices and triangles, renumbering the vertices in their order.
+fn compact<L: Copy>(atlas: &mut Atlas<L>, gone_vertex: &[bool], gone_triangle: &[bool]) {
+    let mut new_id = vec![u32::MAX; gone_vertex.len()];
+    let mut next = 0u32;
+    let mut kept = 0;
+    for (v, &gone) in gone_vertex.iter().enumerate() {
+        if !gone {
+            new_id[v] = next;
+            atlas.positions[kept] = atlas.positions[v];
+            kept += 1;
+            next += 1;
+        }
+    }
+    atlas.positions.truncate(kept);
+    let mut t_kept = 0;
+    for (t, &gone) in gone_triangle.iter().enumerate() {
+        if gone {
+            continue;
+        }
+        atlas.triangles[t_kept] = atlas.triangles[t].map(|v| new_id[v as usize]);
+        atlas.pairs[t_kept] = atlas.pairs[t];
+        t_kept += 1;
+    }
+    atlas.triangles.truncate(t_kept);
+    atlas.pairs.truncate(t_kept);
+}
