@@ -5,7 +5,9 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{Atlas, Label, LabelParams};
-use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, junction};
+use alloc::collections::BTreeMap;
+
+use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
 use crate::tables::NO_EAR;
 use crate::{Error, Mode, Volume};
 
@@ -63,6 +65,29 @@ impl<'a, L: Label> Padded<'a, L> {
         self.data[q[0] + self.dims[0] * (q[1] + self.dims[1] * q[2])]
     }
 
+    /// Copies plane `z` of the padded grid into `out` (`n[0] · n[1]` long).
+    pub fn plane(&self, z: usize, out: &mut [L]) {
+        let [nx, ny, _] = self.n;
+        let [dx, dy, _] = self.dims;
+        if z < self.pad || z >= self.dims[2] + self.pad {
+            out.fill(self.background);
+            return;
+        }
+        let slice = &self.data[(z - self.pad) * dx * dy..][..dx * dy];
+        for y in 0..ny {
+            let row = &mut out[y * nx..][..nx];
+            if y < self.pad || y >= dy + self.pad {
+                row.fill(self.background);
+                continue;
+            }
+            row[self.pad..self.pad + dx].copy_from_slice(&slice[(y - self.pad) * dx..][..dx]);
+            if self.pad > 0 {
+                row[0] = self.background;
+                row[nx - 1] = self.background;
+            }
+        }
+    }
+
     /// The order of labels for the face rule: the background first, then ascending.
     #[inline]
     pub fn key(&self, l: L) -> (bool, L) {
@@ -86,7 +111,9 @@ const fn edge_axis(e: u8) -> usize {
 
 /// Vertex ids of the nodes shared between cubes, for the planes and layer in reach: x- and
 /// y-edges and z-facing face centres of planes `k` and `k + 1` (slot `z % 2`), z-edges and
-/// x- and y-facing face centres of layer `k`.
+/// x- and y-facing face centres of layer `k`. A slot holds its id plus one, and counts only if
+/// that id was made since its plane or layer came into reach: ids grow as the sweep goes, so
+/// moving on is two numbers, not a fill of six planes per layer.
 struct Ids {
     nx: usize,
     x: [Vec<u32>; 2],
@@ -95,11 +122,14 @@ struct Ids {
     z: Vec<u32>,
     fx: Vec<u32>,
     fy: Vec<u32>,
+    /// Per plane slot, and for the layer: the first id made since it came into reach.
+    since: [u32; 2],
+    since_layer: u32,
 }
 
 impl Ids {
     fn new(nx: usize, ny: usize) -> Ids {
-        let plane = || vec![NONE; nx * ny];
+        let plane = || vec![0; nx * ny];
         Ids {
             nx,
             x: [plane(), plane()],
@@ -108,38 +138,56 @@ impl Ids {
             z: plane(),
             fx: plane(),
             fy: plane(),
+            since: [0; 2],
+            since_layer: 0,
         }
     }
 
-    /// Forgets plane `k + 1`'s slot (plane `k − 1`'s until now) and layer `k − 1`.
-    fn next_layer(&mut self, k: usize) {
-        let s = (k + 1) % 2;
-        for ids in [&mut self.x[s], &mut self.y[s], &mut self.fz[s]] {
-            ids.fill(NONE);
-        }
-        for ids in [&mut self.z, &mut self.fx, &mut self.fy] {
-            ids.fill(NONE);
-        }
+    /// Brings plane `k + 1` (in plane `k − 1`'s slot) and layer `k` into reach; `next` is the
+    /// next id to be made.
+    fn next_layer(&mut self, k: usize, next: u32) {
+        self.since[(k + 1) % 2] = next;
+        self.since_layer = next;
     }
 
-    fn edge(&mut self, lower: [usize; 3], axis: usize) -> &mut u32 {
+    /// The slot of the vertex on the edge from `lower` along `axis`, and the first id it may
+    /// hold.
+    #[inline]
+    fn edge(&mut self, lower: [usize; 3], axis: usize) -> (&mut u32, u32) {
         let at = lower[0] + self.nx * lower[1];
+        let s = lower[2] % 2;
         match axis {
-            0 => &mut self.x[lower[2] % 2][at],
-            1 => &mut self.y[lower[2] % 2][at],
-            _ => &mut self.z[at],
+            0 => (&mut self.x[s][at], self.since[s]),
+            1 => (&mut self.y[s][at], self.since[s]),
+            _ => (&mut self.z[at], self.since_layer),
         }
     }
 
-    fn face(&mut self, cube: [usize; 3], f: u8) -> &mut u32 {
+    /// [`Ids::edge`] for the centre of face `f` of `cube`.
+    fn face(&mut self, cube: [usize; 3], f: u8) -> (&mut u32, u32) {
         let side = usize::from(f % 2);
         let [i, j, k] = cube;
         match f / 2 {
-            0 => &mut self.fx[i + side + self.nx * j],
-            1 => &mut self.fy[i + self.nx * (j + side)],
-            _ => &mut self.fz[(k + side) % 2][i + self.nx * j],
+            0 => (&mut self.fx[i + side + self.nx * j], self.since_layer),
+            1 => (&mut self.fy[i + self.nx * (j + side)], self.since_layer),
+            _ => {
+                let s = (k + side) % 2;
+                (&mut self.fz[s][i + self.nx * j], self.since[s])
+            }
         }
     }
+}
+
+/// The vertex in `slot` (see [`Ids`]), made by `make` if it has none yet.
+#[inline]
+fn shared(
+    (slot, since): (&mut u32, u32),
+    make: impl FnOnce() -> Result<u32, Error>,
+) -> Result<u32, Error> {
+    if *slot <= since {
+        *slot = make()? + 1;
+    }
+    Ok(*slot - 1)
 }
 
 /// The sweep's output so far.
@@ -154,7 +202,8 @@ impl<L> Out<'_, L> {
     /// A new vertex at `quarters` (quarters of a cube side) from `cube`'s lower corner.
     fn vertex(&mut self, cube: [usize; 3], quarters: [i32; 3]) -> Result<u32, Error> {
         let id = u32::try_from(self.atlas.positions.len()).map_err(|_| Error::TooManyVertices)?;
-        if id == NONE {
+        // Ids are stored plus one (see `Ids`).
+        if id >= NONE - 1 {
             return Err(Error::TooManyVertices);
         }
         let p: [f32; 3] = core::array::from_fn(|a| {
@@ -193,20 +242,55 @@ pub(super) fn sweep<L: Label>(
     };
     let table = params.tables.for_mode(params.mode);
     let mergeable = params.tables.mergeable();
-    let mut built = Junction::default();
+    let mut patterns = Patterns::default();
+    let mut planes = [
+        vec![grid.background; nx * ny],
+        vec![grid.background; nx * ny],
+    ];
+    let mut mask = vec![0u8; nx];
+    grid.plane(0, &mut planes[0]);
     for k in 0..nz - 1 {
         if k > 0 {
-            ids.next_layer(k);
+            ids.next_layer(k, out.atlas.positions.len() as u32);
         }
+        grid.plane(k + 1, &mut planes[(k + 1) % 2]);
+        let (lower, upper) = (&planes[k % 2], &planes[(k + 1) % 2]);
         for j in 0..ny - 1 {
+            let rows = [
+                &lower[j * nx..][..nx],
+                &lower[(j + 1) * nx..][..nx],
+                &upper[j * nx..][..nx],
+                &upper[(j + 1) * nx..][..nx],
+            ];
+            differs(rows, &mut mask);
             for i in 0..nx - 1 {
+                // Most cubes hold one label: skipped eight at a time.
+                if i % 8 == 0 && i + 8 <= nx - 1 {
+                    let chunk: [u8; 8] = mask[i..i + 8].try_into().unwrap_or([1; 8]);
+                    if u64::from_ne_bytes(chunk) == 0 {
+                        continue;
+                    }
+                }
+                if mask[i] == 0 {
+                    continue;
+                }
+                let labels = [
+                    rows[0][i],
+                    rows[0][i + 1],
+                    rows[1][i],
+                    rows[1][i + 1],
+                    rows[2][i],
+                    rows[2][i + 1],
+                    rows[3][i],
+                    rows[3][i + 1],
+                ];
                 let cube = [i, j, k];
-                let labels: [L; 8] = core::array::from_fn(|c| {
-                    let o = offset(c as u8);
-                    grid.at([i + o[0], j + o[1], k + o[2]])
-                });
                 let keys = labels.map(|l| grid.key(l));
-                match classify(&keys) {
+                let (kind, built) = match few_labels(&keys) {
+                    Some(kind) => (kind, &[][..]),
+                    None => patterns.get(&keys),
+                };
+                match kind {
                     Kind::Uniform => {}
                     Kind::Binary { background, case } => {
                         let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
@@ -239,7 +323,7 @@ pub(super) fn sweep<L: Label>(
                                 continue;
                             }
                             let [back, grey, forward] = entry.tris[usize::from(ear)];
-                            let vertex = *ids.edge(edge_lower(cube, grey), axis);
+                            let vertex = *ids.edge(edge_lower(cube, grey), axis).0 - 1;
                             ears.push(Ear {
                                 vertex,
                                 triangle: first + u32::from(ear),
@@ -253,20 +337,15 @@ pub(super) fn sweep<L: Label>(
                         }
                     }
                     Kind::Junction => {
-                        junction(&keys, &mut built);
                         let mut own = [NONE; 27];
-                        for n in 0..built.len {
+                        for &(triangle, [a, b]) in built {
                             let mut t = [0; 3];
-                            for (v, &local) in t.iter_mut().zip(&built.triangles[n]) {
+                            for (v, &local) in t.iter_mut().zip(&triangle) {
                                 *v = match local {
                                     Local::Edge(e) => edge_vertex(&mut ids, &mut out, cube, e)?,
-                                    Local::Face(f) => {
-                                        let slot = ids.face(cube, f);
-                                        if *slot == NONE {
-                                            *slot = out.vertex(cube, local.quarters())?;
-                                        }
-                                        *slot
-                                    }
+                                    Local::Face(f) => shared(ids.face(cube, f), || {
+                                        out.vertex(cube, local.quarters())
+                                    })?,
                                     Local::Centre | Local::InnerNode(_) | Local::InnerCorner(_) => {
                                         let s = match local {
                                             Local::Centre => 0,
@@ -281,7 +360,6 @@ pub(super) fn sweep<L: Label>(
                                     }
                                 };
                             }
-                            let [a, b] = built.pairs[n];
                             out.triangle(t, [labels[usize::from(a)], labels[usize::from(b)]]);
                         }
                     }
@@ -292,11 +370,88 @@ pub(super) fn sweep<L: Label>(
     Ok(ears)
 }
 
+/// The constructions of cubes with three or more labels met so far, by the order pattern of
+/// their corners' labels: a segmentation has few patterns, and building one takes thousands of
+/// instructions, while a cube reads every label only through comparisons, so cubes of one
+/// pattern are built alike.
+#[derive(Default)]
+struct Patterns {
+    /// Pattern → its kind and its triangles' range in `triangles`.
+    index: BTreeMap<u32, (Kind, usize, usize)>,
+    /// Triangles with, per triangle, a corner on the side it faces away from and one on the
+    /// side it faces toward.
+    triangles: Vec<([Local; 3], [u8; 2])>,
+    built: Junction,
+}
+
+impl Patterns {
+    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[([Local; 3], [u8; 2])]) {
+        let mut sorted = *keys;
+        sorted.sort_unstable();
+        let mut pattern = 0u32;
+        for (c, key) in keys.iter().enumerate() {
+            let rank = sorted[..sorted.partition_point(|k| k < key)]
+                .windows(2)
+                .filter(|w| w[0] != w[1])
+                .count()
+                + usize::from(sorted[0] < *key);
+            pattern |= (rank as u32) << (3 * c);
+        }
+        let (kind, start, len) = match self.index.get(&pattern) {
+            Some(&found) => found,
+            None => {
+                let kind = classify(keys);
+                let start = self.triangles.len();
+                if kind == Kind::Junction {
+                    junction(keys, &mut self.built);
+                    let b = &self.built;
+                    self.triangles
+                        .extend((0..b.len).map(|n| (b.triangles[n], b.pairs[n])));
+                }
+                let entry = (kind, start, self.triangles.len() - start);
+                self.index.insert(pattern, entry);
+                entry
+            }
+        };
+        (kind, &self.triangles[start..start + len])
+    }
+}
+
+/// Per cube of a row, 1 if its eight corners (`rows`: y and y + 1 at z, then at z + 1) do not
+/// all hold one label. Written without branches, so that it vectorises.
+fn differs<L: Label>(rows: [&[L]; 4], mask: &mut [u8]) {
+    let n = mask.len() - 1;
+    let [a, b, c, d] = rows.map(|r| &r[..n + 1]);
+    for i in 0..n {
+        let v = a[i];
+        let any = (a[i + 1] != v)
+            | (b[i] != v)
+            | (b[i + 1] != v)
+            | (c[i] != v)
+            | (c[i + 1] != v)
+            | (d[i] != v)
+            | (d[i + 1] != v);
+        mask[i] = u8::from(any);
+    }
+}
+
 /// The lower end of cube edge `e` of `cube`, in the grid.
+#[inline]
 fn edge_lower(cube: [usize; 3], e: u8) -> [usize; 3] {
-    let o = offset(edge_corners(e).0);
+    let o = EDGE_LOWER[usize::from(e)];
     [cube[0] + o[0], cube[1] + o[1], cube[2] + o[2]]
 }
+
+/// Each cube edge's lower end, from the cube's lower corner.
+const EDGE_LOWER: [[usize; 3]; 12] = {
+    let mut out = [[0; 3]; 12];
+    let mut e = 0;
+    while e < 12 {
+        out[e] = offset(edge_corners(e as u8).0);
+        e += 1;
+    }
+    out
+};
 
 /// The vertex on cube edge `e`, made at its midpoint when first used.
 fn edge_vertex<L>(
@@ -305,11 +460,9 @@ fn edge_vertex<L>(
     cube: [usize; 3],
     e: u8,
 ) -> Result<u32, Error> {
-    let slot = ids.edge(edge_lower(cube, e), edge_axis(e));
-    if *slot == NONE {
-        *slot = out.vertex(cube, Local::Edge(e).quarters())?;
-    }
-    Ok(*slot)
+    shared(ids.edge(edge_lower(cube, e), edge_axis(e)), || {
+        out.vertex(cube, Local::Edge(e).quarters())
+    })
 }
 
 /// Whether the vertex on cube edge `e` is a corner of the merged pair's diagonal for grey edge

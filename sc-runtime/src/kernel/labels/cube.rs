@@ -91,9 +91,36 @@ pub enum Kind {
 
 /// The construction for a cube whose corners have labels ordered by `keys`.
 pub fn classify<K: Ord + Copy>(keys: &[K; 8]) -> Kind {
-    if keys.iter().all(|&k| k == keys[0]) {
-        return Kind::Uniform;
+    few_labels(keys).unwrap_or_else(|| classify_many(keys))
+}
+
+/// [`classify`] for a cube of one or two labels, the common case, which needs no face test:
+/// the smaller label is the background. `None` for three or more.
+#[inline]
+pub fn few_labels<K: Ord + Copy>(keys: &[K; 8]) -> Option<Kind> {
+    let first = keys[0];
+    let mut other = None;
+    let mut two = true;
+    for &k in &keys[1..] {
+        if k != first {
+            match other {
+                None => other = Some(k),
+                Some(o) if o == k => {}
+                Some(_) => {
+                    two = false;
+                    break;
+                }
+            }
+        }
     }
+    let Some(other) = other else {
+        return Some(Kind::Uniform);
+    };
+    two.then(|| binary(keys, first.min(other)))
+}
+
+/// [`classify`] for three or more labels.
+fn classify_many<K: Ord + Copy>(keys: &[K; 8]) -> Kind {
     let splits = FACES.map(|f| split(f.map(|c| keys[c as usize])));
     let mut sorted = *keys;
     sorted.sort_unstable();
@@ -110,19 +137,24 @@ pub fn classify<K: Ord + Copy>(keys: &[K; 8]) -> Kind {
             }
         });
         if agrees {
-            let mut case = 0u8;
-            let mut background = 0u8;
-            for c in (0..8u8).rev() {
-                if keys[c as usize] == w {
-                    background = c;
-                } else {
-                    case |= 1 << c;
-                }
-            }
-            return Kind::Binary { background, case };
+            return binary(keys, w);
         }
     }
     Kind::Junction
+}
+
+/// The binary cube whose empty corners are those with key `w`.
+fn binary<K: Ord + Copy>(keys: &[K; 8], w: K) -> Kind {
+    let mut case = 0u8;
+    let mut background = 0u8;
+    for c in (0..8u8).rev() {
+        if keys[c as usize] == w {
+            background = c;
+        } else {
+            case |= 1 << c;
+        }
+    }
+    Kind::Binary { background, case }
 }
 
 /// A junction cube's triangles.

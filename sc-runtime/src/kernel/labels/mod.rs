@@ -9,5 +9,5 @@
 mod cube;
 mod face;
 
-pub use cube::{Junction, Kind, Local, MAX_TRIANGLES, classify, junction};
+pub use cube::{Junction, Kind, Local, MAX_TRIANGLES, classify, few_labels, junction};
 pub use face::{FACES, corner_edge, edge_corners};
