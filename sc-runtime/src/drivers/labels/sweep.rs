@@ -265,7 +265,7 @@ pub(super) fn sweep<L: Label>(
             differs(rows, &mut mask);
             for i in 0..nx - 1 {
                 // Most cubes hold one label: skipped eight at a time.
-                if i % 8 == 0 && i + 8 <= nx - 1 {
+                if i % 8 == 0 && i + 8 < nx {
                     let chunk: [u8; 8] = mask[i..i + 8].try_into().unwrap_or([1; 8]);
                     if u64::from_ne_bytes(chunk) == 0 {
                         continue;
@@ -370,6 +370,10 @@ pub(super) fn sweep<L: Label>(
     Ok(ears)
 }
 
+/// A junction cube's triangle, with a corner on the side it faces away from and one on the
+/// side it faces toward.
+type Built = ([Local; 3], [u8; 2]);
+
 /// The constructions of cubes with three or more labels met so far, by the order pattern of
 /// their corners' labels: a segmentation has few patterns, and building one takes thousands of
 /// instructions, while a cube reads every label only through comparisons, so cubes of one
@@ -380,12 +384,12 @@ struct Patterns {
     index: BTreeMap<u32, (Kind, usize, usize)>,
     /// Triangles with, per triangle, a corner on the side it faces away from and one on the
     /// side it faces toward.
-    triangles: Vec<([Local; 3], [u8; 2])>,
+    triangles: Vec<Built>,
     built: Junction,
 }
 
 impl Patterns {
-    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[([Local; 3], [u8; 2])]) {
+    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[Built]) {
         let mut sorted = *keys;
         sorted.sort_unstable();
         let mut pattern = 0u32;
