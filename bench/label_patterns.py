@@ -1,100 +1,83 @@
 #!/usr/bin/env python3
-"""Checks of docs/labels.md's face rule, exhaustive over a cube's labellings, and a census of
-junction cubes in real segmentations.
+"""A census of the cube constructions of docs/labels.md in real segmentations.
 
-    python3 bench/label_patterns.py                       # the exhaustive check (about 30 s)
-    SC_DATA_DIR=../shared/data python3 bench/label_patterns.py --census   # needs NumPy
+    SC_DATA_DIR=../shared/data python3 bench/label_patterns.py     # needs NumPy
 
-The check enumerates every ordered labelling of a cube's eight corners (each set partition of
-the corners, with every order of its blocks: 545,835), applies the face rule (the smallest label
-on a face connects, every maximal run of another label is cut off by one side), and counts the
-cubes whose side graph has a node of degree other than two (junction cubes). For the others
-(simple cubes) it asserts that each side's pair is the same at both its ends, and that every side
-is a side of the binary case whose filled corners carry the larger label of its pair.
+For each padded label volume, counts the surface cubes (two or more labels among the corners)
+that are binary, cone and hub cubes. The rules are written here again from docs/labels.md,
+independently of the runtime; the exhaustive check of every labelling is the Rust test
+`every_labelling_of_a_cube` (tests/tests/labels.rs).
 """
 import collections
-import itertools
 import json
 import os
-import sys
 
 # Each face's corners in cyclic order; corner c sits at (c & 1, c >> 1 & 1, c >> 2 & 1).
-FACES = []
-for axis in range(3):
-    others = [a for a in range(3) if a != axis]
-    cycle = {(0, 0): 0, (1, 0): 1, (1, 1): 2, (0, 1): 3}
-    for side in (0, 1):
-        corners = [c for c in range(8) if (c >> axis) & 1 == side]
-        corners.sort(key=lambda c: cycle[((c >> others[0]) & 1, (c >> others[1]) & 1)])
-        FACES.append(corners)
+FACES = [[0, 2, 6, 4], [1, 3, 7, 5], [0, 1, 5, 4], [2, 3, 7, 6], [0, 1, 3, 2], [4, 5, 7, 6]]
 
 
-def edge(a, b):
-    return (min(a, b), max(a, b))
+def split(ls):
+    """The face rule: ('uniform',), ('cut', connector label, either) or ('centre',)."""
+    distinct = set(ls)
+    if len(distinct) == 1:
+        return ("uniform",)
+    if len(distinct) == 2:
+        return ("cut", min(ls), not (ls[0] == ls[2] and ls[1] == ls[3]))
+    if len(distinct) == 3 and (ls[0] == ls[2] or ls[1] == ls[3]):
+        return ("cut", ls[0] if ls[0] == ls[2] else ls[1], False)
+    return ("centre",)
 
 
-def face_sides(labels, face):
-    """The face rule: (edge, edge, cap label, the face's smallest label) per side."""
-    ls = [labels[c] for c in face]
-    m = min(ls)
-    if all(l == m for l in ls):
-        return []
-    start = next(i for i in range(4) if ls[i] != ls[i - 1])
-    sides, i, seen = [], start, 0
-    while seen < 4:
-        j = i
-        while ls[(j + 1) % 4] == ls[i % 4] and j + 1 - i < 4:
-            j += 1
-        if ls[i % 4] != m:
-            first = edge(face[(i - 1) % 4], face[i % 4])
-            last = edge(face[j % 4], face[(j + 1) % 4])
-            sides.append((first, last, ls[i % 4], m))
-        seen += j - i + 1
-        i = (j + 1) % 4
-    return sides
+def pieces(ls, rule):
+    """Groups of a face's positions held by one region."""
+    if rule[0] == "uniform":
+        return [[0, 1, 2, 3]]
+    if rule[0] == "centre":
+        return [[i for i in range(4) if ls[i] == label] for label in set(ls)]
+    w = rule[1]
+    out = [[i for i in range(4) if ls[i] == w]]
+    for i in range(4):
+        if ls[i] != w and ls[i - 1] != ls[i]:
+            run = [i]
+            while ls[(run[-1] + 1) % 4] == ls[i]:
+                run.append((run[-1] + 1) % 4)
+            out.append(run)
+    return out
 
 
-def cube_sides(labels):
-    return [s for f in FACES for s in face_sides(labels, f)]
+def kind(labels):
+    """'binary', 'cone' or 'hub' for a cube of two or more labels."""
+    rules = [split([labels[c] for c in f]) for f in FACES]
+    for w in sorted(set(labels)):
+        if all(r[0] == "uniform" or (r[0] == "cut" and (r[1] == w or (r[2] and w in
+               [labels[c] for c in f]))) for r, f in zip(rules, FACES)):
+            return "binary"
+    parent = list(range(8))
 
-
-def patterns():
-    """Restricted growth strings of the eight corners, each with every order of its blocks."""
-    def rgs(prefix, top):
-        if len(prefix) == 8:
-            yield prefix
-            return
-        for v in range(top + 2):
-            yield from rgs(prefix + [v], max(top, v))
-    for blocks in rgs([0], 0):
-        k = max(blocks) + 1
-        for order in itertools.permutations(range(k)):
-            yield [order[b] for b in blocks], k
-
-
-def check():
-    counts = collections.Counter()
-    for labels, k in patterns():
-        sides = cube_sides(labels)
-        if not sides:
-            continue
-        degree = collections.Counter(e for s in sides for e in s[:2])
-        if any(d != 2 for d in degree.values()):
-            counts["junction", k] += 1
-            continue
-        counts["simple", k] += 1
-        pairs = collections.defaultdict(set)
-        for a, b, x, y in sides:
-            pairs[a].add((x, y))
-            pairs[b].add((x, y))
-        assert all(len(p) == 1 for p in pairs.values()), labels
-        for a, b, x, y in sides:
-            binary = [int(l == x) for l in labels]
-            assert (a, b) in {s[:2] for s in cube_sides(binary)}, labels
-    for key in sorted(counts):
-        print(*key, counts[key])
-    print("simple:", sum(v for (kind, _), v in counts.items() if kind == "simple"),
-          "junction:", sum(v for (kind, _), v in counts.items() if kind == "junction"))
+    def find(x):
+        while parent[x] != x:
+            x = parent[x]
+        return x
+    for f, r in zip(FACES, rules):
+        for group in pieces([labels[c] for c in f], r):
+            for i in group[1:]:
+                parent[find(f[i])] = find(f[group[0]])
+    roots = {c: find(c) for c in range(8)}
+    regions = len(set(roots.values()))
+    one_per_label = all(roots[c] == roots[d] for c in range(8) for d in range(8)
+                        if labels[c] == labels[d])
+    occupied = sum(labels[a] != labels[b] for a in range(8) for b in range(a + 1, 8)
+                   if bin(a ^ b).count("1") == 1)
+    centres = sum(r[0] == "centre" for r in rules)
+    sides = 0
+    for f, r in zip(FACES, rules):
+        ls = [labels[c] for c in f]
+        if r[0] == "centre":
+            sides += sum(ls[i] != ls[(i + 1) % 4] for i in range(4))
+        elif r[0] == "cut":
+            sides += len(pieces(ls, r)) - 1
+    connected = occupied + centres + regions == sides + 2
+    return "cone" if connected and one_per_label else "hub"
 
 
 def census():
@@ -109,11 +92,18 @@ def census():
         z, y, x = (n - 1 for n in v.shape)
         corners = np.stack([v[a:a + z, b:b + y, c:c + x] for a in (0, 1) for b in (0, 1)
                             for c in (0, 1)]).reshape(8, -1)
-        surface = corners[:, corners.min(0) != corners.max(0)]
-        k = 1 + (np.diff(np.sort(surface, axis=0), axis=0) != 0).sum(0)
-        print(f"{name}: {surface.shape[1]} surface cubes, 2 labels {np.mean(k == 2):.3f}, "
-              f"3 labels {np.mean(k == 3):.3f}, 4 or more {np.mean(k >= 4):.3f}")
+        surface = corners[:, corners.min(0) != corners.max(0)].T
+        counts, cache = collections.Counter(), {}
+        for row in map(tuple, surface):
+            order = sorted(set(row))
+            key = tuple(order.index(label) for label in row)
+            if key not in cache:
+                cache[key] = kind(list(key))
+            counts[cache[key]] += 1
+        total = sum(counts.values())
+        print(f"{name}: {total} surface cubes, " + ", ".join(
+            f"{k} {100 * counts[k] / total:.2f} %" for k in ("binary", "cone", "hub")))
 
 
 if __name__ == "__main__":
-    census() if "--census" in sys.argv else check()
+    census()
