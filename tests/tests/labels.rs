@@ -453,6 +453,8 @@ fn voronoi_cells_are_closed_embedded_and_separating() {
             );
         }
     }
+    // Tall enough for three pieces of the sweep, joined.
+    check_volume(&cells([7, 6, 40], 8, 5), Mode::Embedded, "tall cells");
 }
 
 /// With one region and the background, the atlas is the binary engine's mesh of the region's
@@ -510,5 +512,28 @@ fn two_labels_are_the_binary_mesh() {
                 "seed {seed}, {mode:?}"
             );
         }
+    }
+}
+
+/// The sweep runs in pieces of layers on threads: the atlas is the same, vertex for vertex, for
+/// any number of threads, and the same as one piece per layer would make it.
+#[test]
+fn any_thread_count_gives_the_same_atlas() {
+    let vol = cells([9, 8, 53], 14, 7);
+    let volume = Volume::new(&vol.data, vol.dims).unwrap();
+    let atlas = |threads| {
+        extract_labels(
+            volume,
+            &LabelParams {
+                threads,
+                ..LabelParams::default()
+            },
+        )
+        .unwrap()
+    };
+    let one = atlas(1);
+    assert!(one.stats.merged > 0 && one.triangles.len() > 1000);
+    for threads in [2, 3, 0] {
+        assert_eq!(atlas(threads), one, "{threads} threads");
     }
 }

@@ -14,11 +14,11 @@ use alloc::vec::Vec;
 
 use super::sweep::{Ear, Padded};
 use super::{Atlas, Label, LabelParams};
-use crate::{Mode, Volume};
+use crate::Mode;
 
 /// Merges what may merge among `ears`, then drops the vertices and triangles merged away.
 pub(super) fn merge<L: Label>(
-    volume: Volume<'_, L>,
+    grid: &Padded<'_, L>,
     params: &LabelParams<L>,
     mut ears: Vec<Ear<L>>,
     atlas: &mut Atlas<L>,
@@ -26,7 +26,6 @@ pub(super) fn merge<L: Label>(
     if ears.is_empty() {
         return;
     }
-    let grid = Padded::new(volume, params);
     ears.sort_unstable_by_key(|e| e.vertex);
     let mut gone_vertex = vec![false; atlas.positions.len()];
     let mut gone_triangle = vec![false; atlas.triangles.len()];
@@ -36,7 +35,7 @@ pub(super) fn merge<L: Label>(
         let w = a.background;
         let allowed = [b, c, d].iter().all(|e| e.background == w)
             && (params.mode == Mode::Paper
-                || group.iter().all(|e| e.mergeable) && !blocks(&grid, a.lower, a.axis, w));
+                || group.iter().all(|e| e.mergeable) && !blocks(grid, a.lower, a.axis, w));
         let pair = allowed.then(|| quad(atlas, [a, b, c, d])).flatten();
         let Some([first, second]) = pair else {
             atlas.stats.blocked += 1;

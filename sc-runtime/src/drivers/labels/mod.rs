@@ -11,8 +11,12 @@ use alloc::vec::Vec;
 
 use crate::{Error, Mesh, Mode, Stats, Volume};
 
+mod join;
 mod merge;
 mod sweep;
+
+use core::ops::Range;
+use sweep::Padded;
 
 /// A sample type that can hold labels: an integer whose values name regions.
 pub trait Label: Copy + Ord + Send + Sync + core::fmt::Debug + 'static + sealed::Sealed {
@@ -53,10 +57,13 @@ pub struct LabelParams<L> {
     pub origin: [f64; 3],
     /// The case tables; [`crate::tables::DEFAULT`] unless a crate brings its own.
     pub tables: &'static crate::tables::CaseTables,
+    /// Threads to sweep on: 0 for as many as the machine has, 1 for the calling thread alone.
+    /// The atlas does not depend on it. Without the `std` feature, the calling thread alone.
+    pub threads: usize,
 }
 
 impl<L: Label> Default for LabelParams<L> {
-    /// Background 0, embedded mode, padded, unit spacing, the origin at zero.
+    /// Background 0, embedded mode, padded, unit spacing, the origin at zero, every thread.
     fn default() -> Self {
         LabelParams {
             background: L::ZERO,
@@ -65,6 +72,7 @@ impl<L: Label> Default for LabelParams<L> {
             spacing: [1.0; 3],
             origin: [0.0; 3],
             tables: &crate::tables::DEFAULT,
+            threads: 0,
         }
     }
 }
@@ -84,23 +92,80 @@ pub struct Atlas<L> {
 }
 
 /// Meshes the regions of a label volume.
+///
+/// The grid is swept in pieces of a fixed number of layers, on [`LabelParams::threads`]
+/// threads, and the pieces are joined in order, so the atlas is the same for any number of
+/// threads.
 pub fn extract_labels<L: Label>(
     volume: Volume<'_, L>,
     params: &LabelParams<L>,
 ) -> Result<Atlas<L>, Error> {
-    let mut atlas = Atlas {
-        positions: Vec::new(),
-        triangles: Vec::new(),
-        pairs: Vec::new(),
-        stats: Stats::default(),
+    let grid = Padded::new(volume, params);
+    let layers = grid.n[2].saturating_sub(1);
+    let ranges: Vec<Range<usize>> = if grid.n.iter().all(|&n| n >= 2) {
+        (0..layers)
+            .step_by(PIECE_LAYERS)
+            .map(|k| k..(k + PIECE_LAYERS).min(layers))
+            .collect()
+    } else {
+        Vec::new()
     };
-    let ears = sweep::sweep(volume, params, &mut atlas)?;
+    let pieces = sweep_pieces(&grid, params, ranges)?;
+    let (mut atlas, ears) = join::join(pieces);
     atlas.stats.v13 = atlas.positions.len() as u64;
     atlas.stats.t13 = atlas.triangles.len() as u64;
-    merge::merge(volume, params, ears, &mut atlas);
+    merge::merge(&grid, params, ears, &mut atlas);
     atlas.stats.vertices = atlas.positions.len() as u64;
     atlas.stats.triangles = atlas.triangles.len() as u64;
     Ok(atlas)
+}
+
+/// Layers per piece of the sweep: enough that joining costs little, few enough that two
+/// threads share a small volume evenly.
+const PIECE_LAYERS: usize = 16;
+
+/// The pieces of `ranges`, in order, on the threads asked for.
+#[cfg(feature = "std")]
+fn sweep_pieces<L: Label>(
+    grid: &Padded<'_, L>,
+    params: &LabelParams<L>,
+    ranges: Vec<Range<usize>>,
+) -> Result<Vec<sweep::Piece<L>>, Error> {
+    use rayon::prelude::*;
+    let run = || {
+        ranges
+            .par_iter()
+            .map(|r| sweep::sweep(grid, params, r.clone()))
+            .collect()
+    };
+    match params.threads {
+        1 => ranges
+            .into_iter()
+            .map(|r| sweep::sweep(grid, params, r))
+            .collect(),
+        // Rayon's global pool when it has the threads asked for: starting a pool costs a
+        // noticeable share of a small volume's extraction.
+        0 => run(),
+        n if n == rayon::current_num_threads() => run(),
+        n => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|_| Error::ThreadPool)?
+            .install(run),
+    }
+}
+
+/// The pieces of `ranges`, in order, on this thread.
+#[cfg(not(feature = "std"))]
+fn sweep_pieces<L: Label>(
+    grid: &Padded<'_, L>,
+    params: &LabelParams<L>,
+    ranges: Vec<Range<usize>>,
+) -> Result<Vec<sweep::Piece<L>>, Error> {
+    ranges
+        .into_iter()
+        .map(|r| sweep::sweep(grid, params, r))
+        .collect()
 }
 
 impl<L: Label> Atlas<L> {

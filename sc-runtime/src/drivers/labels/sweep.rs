@@ -6,10 +6,11 @@ use alloc::vec::Vec;
 
 use super::{Atlas, Label, LabelParams};
 use alloc::collections::BTreeMap;
+use core::ops::Range;
 
 use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
 use crate::tables::NO_EAR;
-use crate::{Error, Mode, Volume};
+use crate::{Error, Mode, Stats, Volume};
 
 const NONE: u32 = u32::MAX;
 
@@ -150,6 +151,14 @@ impl Ids {
         self.since_layer = next;
     }
 
+    /// Plane `z`'s slots, with those not made since it came into reach cleared.
+    fn plane(&self, z: usize) -> [Vec<u32>; 3] {
+        let s = z % 2;
+        let since = self.since[s];
+        [&self.x[s], &self.y[s], &self.fz[s]]
+            .map(|ids| ids.iter().map(|&v| if v > since { v } else { 0 }).collect())
+    }
+
     /// The slot of the vertex on the edge from `lower` along `axis`, and the first id it may
     /// hold.
     #[inline]
@@ -221,22 +230,35 @@ impl<L> Out<'_, L> {
     }
 }
 
-/// Steps 1–3 into `atlas`; returns the binary cubes' ears on grey edges, for Step 4.
+/// The output of a run of layers, to be joined with its neighbours'.
+pub(super) struct Piece<L> {
+    pub atlas: Atlas<L>,
+    pub ears: Vec<Ear<L>>,
+    /// The vertex slots (ids plus one, 0 for none) of the first plane's x-edges, y-edges and
+    /// face centres, and of the plane after the last layer: the vertices two pieces share.
+    pub bottom: [Vec<u32>; 3],
+    pub top: [Vec<u32>; 3],
+}
+
+/// Steps 1–3 over `layers` of the padded grid. Vertices are numbered as the piece first uses
+/// them, from 0, so a piece depends only on its layers, not on where the sweep started.
 pub(super) fn sweep<L: Label>(
-    volume: Volume<'_, L>,
+    grid: &Padded<'_, L>,
     params: &LabelParams<L>,
-    atlas: &mut Atlas<L>,
-) -> Result<Vec<Ear<L>>, Error> {
-    let grid = Padded::new(volume, params);
-    let [nx, ny, nz] = grid.n;
+    layers: Range<usize>,
+) -> Result<Piece<L>, Error> {
+    let [nx, ny, _] = grid.n;
+    let mut atlas = Atlas {
+        positions: Vec::new(),
+        triangles: Vec::new(),
+        pairs: Vec::new(),
+        stats: Stats::default(),
+    };
     let mut ears = Vec::new();
-    if nx < 2 || ny < 2 || nz < 2 {
-        return Ok(ears);
-    }
     let mut ids = Ids::new(nx, ny);
     let pad = f64::from(u8::from(params.pad));
     let mut out = Out {
-        atlas,
+        atlas: &mut atlas,
         spacing: params.spacing,
         origin: core::array::from_fn(|a| params.origin[a] - pad * params.spacing[a]),
     };
@@ -248,9 +270,14 @@ pub(super) fn sweep<L: Label>(
         vec![grid.background; nx * ny],
     ];
     let mut mask = vec![0u8; nx];
-    grid.plane(0, &mut planes[0]);
-    for k in 0..nz - 1 {
-        if k > 0 {
+    let mut bottom = [Vec::new(), Vec::new(), Vec::new()];
+    let first = layers.start;
+    grid.plane(first, &mut planes[first % 2]);
+    for k in layers.clone() {
+        if k > first {
+            if k == first + 1 {
+                bottom = ids.plane(first);
+            }
             ids.next_layer(k, out.atlas.positions.len() as u32);
         }
         grid.plane(k + 1, &mut planes[(k + 1) % 2]);
@@ -367,7 +394,16 @@ pub(super) fn sweep<L: Label>(
             }
         }
     }
-    Ok(ears)
+    if layers.len() == 1 {
+        bottom = ids.plane(first);
+    }
+    let top = ids.plane(layers.end);
+    Ok(Piece {
+        atlas,
+        ears,
+        bottom,
+        top,
+    })
 }
 
 /// A junction cube's triangle, with a corner on the side it faces away from and one on the

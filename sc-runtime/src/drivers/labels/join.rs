@@ -1,0 +1,71 @@
+//! Joining the pieces of a label sweep: the vertices of the plane two pieces share were made
+//! by both, and are kept once, with the lower piece's number.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::sweep::{Ear, Piece};
+use super::{Atlas, Label};
+use crate::Stats;
+
+/// The pieces, in order of their layers, as one atlas, with their ears renumbered alike.
+pub(super) fn join<L: Label>(pieces: Vec<Piece<L>>) -> (Atlas<L>, Vec<Ear<L>>) {
+    let mut atlas = Atlas {
+        positions: Vec::new(),
+        triangles: Vec::new(),
+        pairs: Vec::new(),
+        stats: Stats::default(),
+    };
+    let mut ears = Vec::new();
+    // The previous piece's top plane, in the joined numbering (plus one, 0 for none).
+    let mut shared: Option<[Vec<u32>; 3]> = None;
+    for piece in pieces {
+        let mut number = vec![u32::MAX; piece.atlas.positions.len()];
+        if let Some(below) = &shared {
+            for (mine, theirs) in piece.bottom.iter().zip(below) {
+                for (&m, &t) in mine.iter().zip(theirs) {
+                    if m != 0 {
+                        debug_assert!(
+                            t != 0,
+                            "a vertex of the shared plane made by one piece only"
+                        );
+                        number[m as usize - 1] = t - 1;
+                    }
+                }
+            }
+        }
+        for (n, p) in number.iter_mut().zip(&piece.atlas.positions) {
+            if *n == u32::MAX {
+                *n = atlas.positions.len() as u32;
+                atlas.positions.push(*p);
+            }
+        }
+        let first_triangle = atlas.triangles.len() as u32;
+        atlas.triangles.extend(
+            piece
+                .atlas
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| number[v as usize])),
+        );
+        atlas.pairs.extend_from_slice(&piece.atlas.pairs);
+        ears.extend(piece.ears.into_iter().map(|ear| Ear {
+            vertex: number[ear.vertex as usize],
+            triangle: first_triangle + ear.triangle,
+            ..ear
+        }));
+        shared = Some(piece.top.map(|plane| {
+            plane
+                .iter()
+                .map(|&v| {
+                    if v == 0 {
+                        0
+                    } else {
+                        number[v as usize - 1] + 1
+                    }
+                })
+                .collect()
+        }));
+    }
+    (atlas, ears)
+}
