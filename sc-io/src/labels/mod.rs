@@ -156,6 +156,28 @@ pub fn tables_beside(volume: &Path) -> Vec<PathBuf> {
     found
 }
 
+/// The colour of label `id` when no table gives one: hues a golden angle apart (distinct for
+/// neighbouring ids, which are often neighbouring regions), saturated and light enough to tell
+/// apart on a dark or a light background. A function of the id alone, so a label keeps its
+/// colour from one file to the next whatever else is meshed.
+pub fn default_rgb(id: u64) -> [u8; 3] {
+    // The fraction of a turn: id × (golden ratio − 1), modulo 1, exact for any u64 id.
+    const STEP: u64 = 0x9E37_79B9_7F4A_7C15; // 2^64 / golden ratio
+    let hue = id.wrapping_mul(STEP) as f64 / 2f64.powi(64) * 6.0;
+    let (s, v) = (0.6, 0.9);
+    let f = hue.fract();
+    let (p, q, t) = (v * (1.0 - s), v * (1.0 - s * f), v * (1.0 - s * (1.0 - f)));
+    let (r, g, b) = match hue as u32 {
+        0 => (v, t, p),
+        1 => (q, v, p),
+        2 => (p, v, t),
+        3 => (p, q, v),
+        4 => (t, p, v),
+        _ => (v, p, q),
+    };
+    [r, g, b].map(|c| (c * 255.0).round() as u8)
+}
+
 /// The longest part of a file name taken from a label's name, in bytes: with the id, the
 /// extension and the temporary name's additions, far below the usual 255-byte limit.
 const MAX_NAME_BYTES: usize = 80;
@@ -219,22 +241,80 @@ mod tests {
         }
     }
 
+    /// Default colours: the same for the same id; ids up to 4 apart differ by more than 50 in
+    /// some channel; the first 256 are all different.
+    #[test]
+    fn default_colours_are_stable_and_distinct() {
+        assert_eq!(default_rgb(17), default_rgb(17));
+        let colours: Vec<[u8; 3]> = (0..1000).map(default_rgb).collect();
+        for (i, a) in colours.iter().enumerate() {
+            for b in &colours[i.saturating_sub(4)..i] {
+                assert!(
+                    a.iter().zip(b).any(|(x, y)| x.abs_diff(*y) > 50),
+                    "{a:?} {b:?}"
+                );
+            }
+        }
+        let first: std::collections::HashSet<_> = colours[..256].iter().collect();
+        assert_eq!(first.len(), 256);
+        // Every component within the HSV bounds chosen: value 0.9, saturation 0.6.
+        assert!(colours.iter().flatten().all(|&c| (91..=230).contains(&c)));
+    }
+
     #[test]
     fn merge_keeps_names_and_fills_colours() {
         let names: LabelTable = [
-            (1, Label { name: "one".into(), rgb: None }),
-            (2, Label { name: "two".into(), rgb: Some([1, 2, 3]) }),
+            (
+                1,
+                Label {
+                    name: "one".into(),
+                    rgb: None,
+                },
+            ),
+            (
+                2,
+                Label {
+                    name: "two".into(),
+                    rgb: Some([1, 2, 3]),
+                },
+            ),
         ]
         .into_iter()
         .collect();
         let palette: LabelTable = (0..4)
-            .map(|id| (id, Label { name: String::new(), rgb: Some([id as u8; 3]) }))
+            .map(|id| {
+                (
+                    id,
+                    Label {
+                        name: String::new(),
+                        rgb: Some([id as u8; 3]),
+                    },
+                )
+            })
             .collect();
         let merged = names.merge(palette);
         assert_eq!(merged.len(), 4);
-        assert_eq!(merged.get(1), Some(&Label { name: "one".into(), rgb: Some([1; 3]) }));
-        assert_eq!(merged.get(2), Some(&Label { name: "two".into(), rgb: Some([1, 2, 3]) }));
-        assert_eq!(merged.get(3), Some(&Label { name: String::new(), rgb: Some([3; 3]) }));
+        assert_eq!(
+            merged.get(1),
+            Some(&Label {
+                name: "one".into(),
+                rgb: Some([1; 3])
+            })
+        );
+        assert_eq!(
+            merged.get(2),
+            Some(&Label {
+                name: "two".into(),
+                rgb: Some([1, 2, 3])
+            })
+        );
+        assert_eq!(
+            merged.get(3),
+            Some(&Label {
+                name: String::new(),
+                rgb: Some([3; 3])
+            })
+        );
         assert_eq!(merged.get(4), None);
     }
 

@@ -26,9 +26,7 @@ impl Format {
             Format::ItkSnap => {
                 "an ITK-SNAP label description line, IDX R G B A VIS MSH \"LABEL\", was expected"
             }
-            Format::FreeSurfer => {
-                "a FreeSurfer colour table line, id name R G B A, was expected"
-            }
+            Format::FreeSurfer => "a FreeSurfer colour table line, id name R G B A, was expected",
             Format::Names => "a label line, id name, was expected",
         }
     }
@@ -170,7 +168,10 @@ fn itk_snap(line: &str) -> Result<(u64, Label), String> {
     }
     for flag in &fields[5..7] {
         if flag.parse::<i64>().is_err() {
-            return Err(format!("visibility flag {} is not a whole number", shown(flag)));
+            return Err(format!(
+                "visibility flag {} is not a whole number",
+                shown(flag)
+            ));
         }
     }
     Ok((id, label(name, Some(rgb))?))
@@ -198,10 +199,7 @@ fn names(line: &str) -> Result<(u64, Label), String> {
         Some((id, rest)) => (id.trim(), rest.split('\t').next().unwrap_or("").trim()),
         None => {
             let mut fields = line.split_whitespace();
-            (
-                fields.next().unwrap_or(""),
-                fields.next().unwrap_or(""),
-            )
+            (fields.next().unwrap_or(""), fields.next().unwrap_or(""))
         }
     };
     let id = id(id_text)?;
@@ -229,7 +227,10 @@ fn id(text: &str) -> Result<u64, String> {
         let digits = !magnitude.is_empty() && magnitude.bytes().all(|b| b.is_ascii_digit());
         match (digits, text.starts_with('-')) {
             (true, true) => format!("label id {} is negative", cut(text)),
-            (true, false) => format!("label id {} is larger than the largest, 2^64 - 1", cut(text)),
+            (true, false) => format!(
+                "label id {} is larger than the largest, 2^64 - 1",
+                cut(text)
+            ),
             _ => format!("{} is not a label id (a whole number)", shown(text)),
         }
     })
@@ -288,7 +289,10 @@ mod tests {
 
         let fs = "#$Id$\n\n#No. Label Name: R G B A\n\n0   Unknown  0   0   0   0\r\n14175 wm_rh_S_temporal_transverse 221 60 60 0\n";
         let t = parse(fs).unwrap();
-        assert_eq!(t[&14175], named("wm_rh_S_temporal_transverse", Some([221, 60, 60])));
+        assert_eq!(
+            t[&14175],
+            named("wm_rh_S_temporal_transverse", Some([221, 60, 60]))
+        );
 
         let tabs = "0\tUnclassified\r\n2\tPontine crossing tract\textra\r\n";
         let t = parse(tabs).unwrap();
@@ -323,14 +327,32 @@ mod tests {
             ("# only a comment\n\n", "no labels"),
             ("1 a\nx b\n", "line 2: \"x\" is not a label id"),
             ("1 a\n-3 b\n", "line 2: label id -3 is negative"),
-            ("1 a\n18446744073709551616 b\n", "line 2: label id 18446744073709551616 is larger"),
-            ("1 a\n99999999999999999999999999999999999999999 b\n", "line 2: label id 9999"),
+            (
+                "1 a\n18446744073709551616 b\n",
+                "line 2: label id 18446744073709551616 is larger",
+            ),
+            (
+                "1 a\n99999999999999999999999999999999999999999 b\n",
+                "line 2: label id 9999",
+            ),
             ("1 a\n2 b\n1 c\n", "line 3: label 1 again (first on line 1)"),
             ("1 a\n2\n", "line 2: label 2 has no name"),
-            ("0 Unknown 0 0 0 0\n1 Left 300 0 0 0\n", "line 2: red \"300\" is not a whole number"),
-            ("0 Unknown 0 0 0 0\n1 Left 1 2\n", "line 2: a FreeSurfer colour table line"),
-            ("0 0 0 0 0 0 0 \"a\"\n1 1 1 1 1 1 1 b\n", "line 2: the label's name is not in double quotes"),
-            ("0 0 0 0 0 0 0 \"a\"\n1 1 1 \"b\"\n", "line 2: an ITK-SNAP label description line"),
+            (
+                "0 Unknown 0 0 0 0\n1 Left 300 0 0 0\n",
+                "line 2: red \"300\" is not a whole number",
+            ),
+            (
+                "0 Unknown 0 0 0 0\n1 Left 1 2\n",
+                "line 2: a FreeSurfer colour table line",
+            ),
+            (
+                "0 0 0 0 0 0 0 \"a\"\n1 1 1 1 1 1 1 b\n",
+                "line 2: the label's name is not in double quotes",
+            ),
+            (
+                "0 0 0 0 0 0 0 \"a\"\n1 1 1 \"b\"\n",
+                "line 2: an ITK-SNAP label description line",
+            ),
             ("1 a\n2 b\u{1b}[31m\n", "line 2: binary data"),
             ("1 a\n\n2 \u{0}\u{1}\u{2}\n", "line 3: binary data"),
         ];
