@@ -111,7 +111,10 @@ fn tables_beside_the_crop_merge() {
             data("aal-crop-24x24x16.u8.lut")
         ]
     );
-    let t = LabelTable::beside(&volume).unwrap().unwrap();
+    let beside = LabelTable::beside(&volume);
+    assert_eq!(beside.sources, found);
+    assert!(beside.unread.is_empty());
+    let t = beside.table.unwrap();
     assert_eq!(t.len(), 256);
     assert_eq!(t.get(73), Some(&label("Putamen_L", Some([72, 72, 200]))));
     let lut = LabelTable::read(&data("aal-crop-24x24x16.u8.lut")).unwrap();
@@ -170,10 +173,16 @@ fn hostile_files_are_named() {
         .to_string();
     assert!(err.contains("none.txt: no such file"), "{err}");
     assert!(LabelTable::read(dir.path()).is_err());
-    // A table beside a volume that does not parse is an error too, naming it.
+    // A table beside a volume that does not parse is set aside with its error; one that does
+    // is read.
     let volume = dir.path().join("seg.nii.gz");
     std::fs::write(dir.path().join("seg.nii.txt"), "1 a\n1 b\n").unwrap();
-    let err = LabelTable::beside(&volume).unwrap_err().to_string();
+    std::fs::write(dir.path().join("seg.txt"), "1 a\n2 b\n").unwrap();
+    let beside = LabelTable::beside(&volume);
+    assert_eq!(beside.sources, [dir.path().join("seg.txt")]);
+    assert_eq!(beside.table.unwrap().len(), 2);
+    assert_eq!(beside.unread.len(), 1);
+    let err = beside.unread[0].to_string();
     assert!(err.contains("seg.nii.txt: line 2"), "{err}");
 }
 
@@ -485,4 +494,60 @@ fn label_files_all_or_nothing() {
     let two = [meshes[0], LabelMesh { id: 2, ..meshes[0] }];
     assert!(LabelFiles::fill(&dir, &two, MeshFormat::Ply, &WriteOptions::default()).is_err());
     assert_eq!(entries(&dir), ["label-2.ply"]);
+}
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn read_bytes(name: &str, bytes: &[u8]) -> sc_io::Result<LabelTable> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        LabelTable::read(&path)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// Any bytes: a table or an error naming the file, never a panic.
+        #[test]
+        fn any_bytes_read_or_refused(bytes in proptest::collection::vec(any::<u8>(), 0..2000), lut in any::<bool>()) {
+            let name = if lut { "t.lut" } else { "t.txt" };
+            if let Err(e) = read_bytes(name, &bytes) {
+                prop_assert!(e.to_string().contains(name));
+            }
+        }
+
+        /// Labels written in each text format read back as written.
+        #[test]
+        fn each_format_round_trips(
+            labels in proptest::collection::btree_map(
+                any::<u64>(),
+                ("[A-Za-z][A-Za-z0-9_()-]{0,20}", any::<[u8; 3]>()),
+                1..40,
+            ),
+        ) {
+            let mut itk = String::from("# ITK-SnAP Label Description File\n");
+            let mut fs = String::from("#No. Label Name: R G B A\r\n\r\n");
+            let mut names = String::new();
+            for (id, (name, [r, g, b])) in &labels {
+                itk.push_str(&format!("{id:>5} {r:>5} {g:>4} {b:>4}        1  1  1    \"{name} x\"\n"));
+                fs.push_str(&format!("{id:<4} {name:<40}{r:<4}{g:<4}{b:<4}0\r\n"));
+                names.push_str(&format!("{id}\t{name} y\r\n"));
+            }
+            let read = |text: &str| read_bytes("t.txt", text.as_bytes()).unwrap();
+            let want = |suffix: &str, coloured: bool| -> LabelTable {
+                labels
+                    .iter()
+                    .map(|(&id, (name, rgb))| {
+                        (id, label(&format!("{name}{suffix}"), coloured.then_some(*rgb)))
+                    })
+                    .collect()
+            };
+            prop_assert_eq!(read(&itk), want(" x", true));
+            prop_assert_eq!(read(&fs), want("", true));
+            prop_assert_eq!(read(&names), want(" y", false));
+        }
+    }
 }

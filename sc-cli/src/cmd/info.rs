@@ -9,7 +9,7 @@ use crate::histogram::Histogram;
 use crate::progress::Bar;
 use crate::summary::thousands;
 use sc_io::Result;
-use sc_io::labels::{LabelTable, tables_beside};
+use sc_io::labels::LabelTable;
 use sc_io::read;
 use sc_io::read::dicom::{self, SeriesInfo};
 use sc_io::volume::{Dtype, Grid, Range};
@@ -80,29 +80,21 @@ impl Table {
                 problems: Vec::new(),
             });
         }
-        let mut table = Table {
-            labels: None,
-            sources: String::new(),
-            problems: Vec::new(),
+        let beside = LabelTable::beside(&args.input);
+        let names: Vec<_> = beside
+            .sources
+            .iter()
+            .map(|p| p.file_name().unwrap_or_default().to_string_lossy())
+            .collect();
+        let table = Table {
+            labels: beside.table,
+            sources: names.join(", "),
+            problems: beside
+                .unread
+                .iter()
+                .map(|e| format!("not read as a label table: {e}"))
+                .collect(),
         };
-        for path in tables_beside(&args.input) {
-            match LabelTable::read(&path) {
-                Ok(read) => {
-                    table.labels = Some(match table.labels.take() {
-                        Some(names) => names.merge(read),
-                        None => read,
-                    });
-                    let file = path.file_name().unwrap_or_default().to_string_lossy();
-                    if !table.sources.is_empty() {
-                        table.sources.push_str(", ");
-                    }
-                    table.sources.push_str(&file);
-                }
-                Err(e) => table
-                    .problems
-                    .push(format!("not read as a label table: {e}")),
-            }
-        }
         Ok(table)
     }
 }

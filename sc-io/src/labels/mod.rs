@@ -11,7 +11,8 @@
 //!   indexed by label id. A palette names no label: its labels have empty names.
 //!
 //! MRIcron ships names and palette as two files; [`LabelTable::beside`] finds and
-//! [`LabelTable::merge`]s them.
+//! [`LabelTable::merge`]s them. [`file_stem`] names a label's mesh file, [`default_rgb`] colours
+//! a label no table colours.
 
 mod parse;
 
@@ -65,17 +66,24 @@ impl LabelTable {
     }
 
     /// The tables found beside `volume` (see [`tables_beside`]), read and merged: the first
-    /// found gives the names, later ones fill in colours. `None` if there is none.
-    pub fn beside(volume: &Path) -> Result<Option<LabelTable>> {
-        let mut merged: Option<LabelTable> = None;
+    /// read gives the names, later ones fill in colours. A table that cannot be read is kept
+    /// in [`Beside::unread`] rather than failing: a file named like a table beside a volume may
+    /// be anything, and the front end decides whether that matters.
+    pub fn beside(volume: &Path) -> Beside {
+        let mut found = Beside::default();
         for path in tables_beside(volume) {
-            let table = LabelTable::read(&path)?;
-            merged = Some(match merged {
-                Some(names) => names.merge(table),
-                None => table,
-            });
+            match LabelTable::read(&path) {
+                Ok(table) => {
+                    found.table = Some(match found.table.take() {
+                        Some(names) => names.merge(table),
+                        None => table,
+                    });
+                    found.sources.push(path);
+                }
+                Err(e) => found.unread.push(e),
+            }
         }
-        Ok(merged)
+        found
     }
 
     /// The label `id`, if the table has it.
@@ -120,6 +128,17 @@ impl FromIterator<(u64, Label)> for LabelTable {
             labels: iter.into_iter().collect(),
         }
     }
+}
+
+/// The label tables beside a volume, as [`LabelTable::beside`] finds them.
+#[derive(Debug, Default)]
+pub struct Beside {
+    /// The tables read, merged; `None` if none was.
+    pub table: Option<LabelTable>,
+    /// The files read, in the order merged.
+    pub sources: Vec<PathBuf>,
+    /// Why each file that looked like a table could not be read.
+    pub unread: Vec<Error>,
 }
 
 /// Whether `path` names a binary MRIcron palette.
