@@ -185,10 +185,10 @@ fn free_surfer(line: &str) -> Result<(u64, Label), String> {
     }
     let id = id(fields[0])?;
     let rgb = rgb(&fields[2..5])?;
-    if let Some(a) = fields.get(5) {
-        if a.parse::<i64>().is_err() {
-            return Err(format!("alpha {} is not a whole number", shown(a)));
-        }
+    if let Some(a) = fields.get(5)
+        && a.parse::<i64>().is_err()
+    {
+        return Err(format!("alpha {} is not a whole number", shown(a)));
     }
     Ok((id, label(fields[1], Some(rgb))?))
 }

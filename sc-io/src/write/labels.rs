@@ -25,8 +25,10 @@ pub struct LabelMesh<'a> {
 /// `17-Left-Hippocampus.ply`, `label-17.ply` for a label without a name. Every file is written
 /// to a temporary file in the directory first ([`AtomicFile::fill`]); only when all are complete
 /// does [`commit`](Self::commit) rename them, so an error while writing (a full disk) or an
-/// interruption leaves the directory as it was. Files of the directory that the set does not
-/// name (those of an earlier run with other labels) are left alone.
+/// interruption leaves none of the set's files (a directory made for the set is removed again
+/// after an error; the signal handler's [`remove_pending`](crate::atomic::remove_pending) removes
+/// the temporary files, not the directory). Files of the directory that the set does not name
+/// (those of an earlier run with other labels) are left alone. The ids must differ.
 ///
 /// Staging in a temporary directory renamed over the target would make the set appear in one
 /// step, but cannot replace a directory that already holds files, which is the usual case on a

@@ -6,7 +6,7 @@
 //! (`--label-table`), or a table found beside it names every non-zero value, or it is
 //! piecewise constant: at least 3/4 of the pairs of face-neighbouring
 //! samples that are both non-zero hold the same value. On the project's real data, scans fail
-//! that test by far (2 to 31 % of such pairs are equal in the MRIs, 59 % in a CT stored in 33
+//! that test by far (2 to 27 % of such pairs are equal in the MRIs, 59 % in a CT stored in 33
 //! levels) and label volumes pass it (89 % for ITK's noisy k-means classes, 95 % for AAL, 98 %
 //! for JHU's tracts); the limit sits between. Floating-point segmentations are not recognised.
 
