@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 use common::fixture;
@@ -25,6 +25,19 @@ fn info(args: &[&str], volume: &Path) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()
+}
+
+/// The raw volume `fixture` (`.raw` and its `.json` sidecar) copied into `dir` as `name`, without
+/// the tables beside it; its sidecar's path.
+fn copy(dir: &tempfile::TempDir, fixture_stem: &str, name: &str) -> PathBuf {
+    for ext in ["json", "raw"] {
+        std::fs::copy(
+            fixture(&format!("{fixture_stem}.{ext}")),
+            dir.path().join(format!("{name}.{ext}")),
+        )
+        .unwrap();
+    }
+    dir.path().join(format!("{name}.json"))
 }
 
 /// The crop's sample counts, counted from the AAL volume independently of this program (and
@@ -96,14 +109,7 @@ fn labels_named_from_the_tables_beside() {
 #[test]
 fn labels_without_a_table_with_one_given_and_with_a_broken_one() {
     let dir = tempfile::tempdir().unwrap();
-    for ext in ["json", "raw"] {
-        std::fs::copy(
-            fixture(&format!("labels/aal-crop-24x24x16.u8.{ext}")),
-            dir.path().join(format!("seg.{ext}")),
-        )
-        .unwrap();
-    }
-    let seg = dir.path().join("seg.json");
+    let seg = copy(&dir, "labels/aal-crop-24x24x16.u8", "seg");
     let report = info(&[], &seg);
     assert!(
         report.contains("  table     none (give one with --label-table)\n"),
@@ -152,14 +158,7 @@ fn labels_without_a_table_with_one_given_and_with_a_broken_one() {
 #[test]
 fn scans_are_not_labels() {
     let dir = tempfile::tempdir().unwrap();
-    for ext in ["json", "raw"] {
-        std::fs::copy(
-            fixture(&format!("itk-t1-crop-40x40x30.i16.{ext}")),
-            dir.path().join(format!("scan.{ext}")),
-        )
-        .unwrap();
-    }
-    let scan = dir.path().join("scan.json");
+    let scan = copy(&dir, "itk-t1-crop-40x40x30.i16", "scan");
     let report = info(&[], &scan);
     assert!(
         report.contains("histogram") && report.contains("Otsu"),
