@@ -86,7 +86,7 @@ impl Table {
             .iter()
             .map(|p| p.file_name().unwrap_or_default().to_string_lossy())
             .collect();
-        let table = Table {
+        Ok(Table {
             labels: beside.table,
             sources: names.join(", "),
             problems: beside
@@ -94,8 +94,7 @@ impl Table {
                 .iter()
                 .map(|e| format!("not read as a label table: {e}"))
                 .collect(),
-        };
-        Ok(table)
+        })
     }
 }
 
