@@ -325,6 +325,10 @@ pub struct InfoArgs {
     /// Histogram bins to print.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=256))]
     pub bins: u16,
+    /// The label table naming the labels of a label volume (ITK-SNAP, FreeSurfer, MRIcron .txt
+    /// or .lut); by default the tables beside the volume (aal.nii.gz: aal.nii.txt, aal.nii.lut).
+    #[arg(long, value_name = "FILE")]
+    pub label_table: Option<PathBuf>,
     /// How to read the volume.
     #[command(flatten)]
     pub read: InputArgs,

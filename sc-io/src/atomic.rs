@@ -14,7 +14,7 @@ use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use tempfile::NamedTempFile;
+use tempfile::{NamedTempFile, TempPath};
 
 use crate::error::{Error, Result};
 
@@ -204,7 +204,21 @@ impl AtomicFile {
         out.flush().map_err(fail)?;
         drop(out);
         self.temp.as_file().sync_all().map_err(fail)?;
-        Ok(Filled(self))
+        // The file is closed here, keeping only its name: a run with hundreds of outputs (a file
+        // per label) would otherwise hold a descriptor for each until the renames, past the usual
+        // limit of 256 (macOS) or 1024 (Linux).
+        let AtomicFile {
+            temp,
+            target,
+            dest,
+            _pending,
+        } = self;
+        Ok(Filled {
+            temp: temp.into_temp_path(),
+            target,
+            dest,
+            _pending,
+        })
     }
 }
 
@@ -280,18 +294,27 @@ impl Seek for Output<'_> {
     }
 }
 
-/// A complete temporary file, waiting to be renamed over its target.
-pub struct Filled(AtomicFile);
+/// A complete temporary file, closed, waiting to be renamed over its target.
+pub struct Filled {
+    temp: TempPath,
+    target: PathBuf,
+    dest: PathBuf,
+    _pending: Pending,
+}
 
 impl Filled {
     /// Renames the file over its target.
     pub fn commit(self) -> Result<()> {
-        let AtomicFile {
+        let Filled {
             temp, target, dest, ..
-        } = self.0;
+        } = self;
         temp.persist(&dest)
-            .map(drop)
             .map_err(|e| Error::file(&target, format!("cannot write: {}", io_reason(&e.error))))
+    }
+
+    /// The path the file is renamed to: the target, or the file its symbolic links lead to.
+    pub fn destination(&self) -> &Path {
+        &self.dest
     }
 }
 

@@ -41,6 +41,7 @@ pub mod atomic;
 mod buffer;
 mod error;
 mod input;
+pub mod labels;
 pub mod limits;
 pub mod mesh_in;
 pub mod progress;

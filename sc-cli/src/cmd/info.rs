@@ -1,5 +1,7 @@
 //! `skelclimb info`.
 
+mod labels;
+
 use std::fmt::Write as _;
 
 use crate::cli::InfoArgs;
@@ -7,6 +9,7 @@ use crate::histogram::Histogram;
 use crate::progress::Bar;
 use crate::summary::thousands;
 use sc_io::Result;
+use sc_io::labels::LabelTable;
 use sc_io::read;
 use sc_io::read::dicom::{self, SeriesInfo};
 use sc_io::volume::{Dtype, Grid, Range};
@@ -14,7 +17,8 @@ use sc_io::volume::{Dtype, Grid, Range};
 /// Bins behind the suggestions: fine enough to separate tissues, coarse enough to smooth noise.
 const SUGGESTION_BINS: usize = 128;
 
-/// Prints what is known about the volume and which iso values to try.
+/// Prints what is known about the volume and which iso values to try, or, for a label volume,
+/// its labels (see [`labels`] for how one is told).
 pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
     let options = args.read.read_options();
     if args.input.is_dir() && options.dicom.series.is_none() {
@@ -28,15 +32,70 @@ pub fn run(args: &InfoArgs, quiet: bool) -> Result<()> {
     let mut grid = read::read(&args.input, &options, &progress)?;
     args.placement.apply(&mut grid);
     progress.finish();
-    print!(
-        "{}",
-        describe(
-            &args.input.display().to_string(),
-            &grid,
-            usize::from(args.bins)
-        )
-    );
+    let name = args.input.display().to_string();
+    let table = Table::of(args)?;
+    let given = args.label_table.is_some();
+    let report = match labels::census(&grid, table.labels.as_ref(), given) {
+        Some(census) => {
+            let mut out = header(&name, &grid);
+            labels::describe(&mut out, &census, table.labels.as_ref(), &table.sources);
+            for problem in &table.problems {
+                let _ = writeln!(out, "  warning   {problem}");
+            }
+            footer(&mut out, &grid);
+            out
+        }
+        None => {
+            let mut out = describe(&name, &grid, usize::from(args.bins));
+            if let Some(given) = &args.label_table {
+                let _ = writeln!(
+                    out,
+                    "  warning   --label-table {} unused: not a label volume (labels are whole numbers from 0, stored without rescaling, at most {} of them)",
+                    given.display(),
+                    thousands(labels::MAX_LABELS as u64)
+                );
+            }
+            out
+        }
+    };
+    print!("{report}");
     Ok(())
+}
+
+/// The label table for `info`: the one given, else those beside the volume that read (a table
+/// beside it that does not is reported, not fatal: it may be any `.txt`).
+struct Table {
+    labels: Option<LabelTable>,
+    /// Where the names and colours come from, for the report.
+    sources: String,
+    problems: Vec<String>,
+}
+
+impl Table {
+    fn of(args: &InfoArgs) -> Result<Table> {
+        if let Some(path) = &args.label_table {
+            return Ok(Table {
+                labels: Some(LabelTable::read(path)?),
+                sources: path.display().to_string(),
+                problems: Vec::new(),
+            });
+        }
+        let beside = LabelTable::beside(&args.input);
+        let names: Vec<_> = beside
+            .sources
+            .iter()
+            .map(|p| p.file_name().unwrap_or_default().to_string_lossy())
+            .collect();
+        Ok(Table {
+            labels: beside.table,
+            sources: names.join(", "),
+            problems: beside
+                .unread
+                .iter()
+                .map(|e| format!("not read as a label table: {e}"))
+                .collect(),
+        })
+    }
 }
 
 /// The series of a DICOM directory that holds several, as text.
@@ -62,62 +121,10 @@ pub fn list(name: &str, series: &[SeriesInfo]) -> String {
 
 /// The report, as text.
 pub fn describe(name: &str, grid: &Grid, bins: usize) -> String {
-    let mut out = String::new();
-    let [nx, ny, nz] = grid.dims;
-    let [sx, sy, sz] = grid.spacing;
-    let [ox, oy, oz] = grid.origin;
+    let mut out = header(name, grid);
     let range = grid.range();
     let shown = Histogram::of(grid, &range, bins);
     let fine = Histogram::of(grid, &range, SUGGESTION_BINS);
-    // `fmt::Write` for `String` cannot fail.
-    let _ = writeln!(out, "{name}");
-    let _ = writeln!(out, "  format    {}", grid.format);
-    let _ = writeln!(
-        out,
-        "  dims      {nx} × {ny} × {nz} ({} samples)",
-        thousands(grid.len() as u64)
-    );
-    let _ = writeln!(out, "  dtype     {}", grid.samples.dtype().name());
-    if !grid.scale.is_identity() {
-        let _ = writeln!(
-            out,
-            "  rescale   value = {} × stored + {}",
-            grid.scale.slope, grid.scale.inter
-        );
-    }
-    let _ = writeln!(
-        out,
-        "  spacing   {} × {} × {}",
-        short(sx),
-        short(sy),
-        short(sz)
-    );
-    let _ = writeln!(
-        out,
-        "  origin    {}, {}, {}",
-        short(ox),
-        short(oy),
-        short(oz)
-    );
-    if let Some(frame) = grid.frame {
-        let d = frame.direction;
-        let axis = |a: usize| {
-            format!(
-                "({}, {}, {})",
-                short(d[0][a]),
-                short(d[1][a]),
-                short(d[2][a])
-            )
-        };
-        let _ = writeln!(
-            out,
-            "  axes      x → {}, y → {}, z → {} ({} world)",
-            axis(0),
-            axis(1),
-            axis(2),
-            frame.space.name()
-        );
-    }
     if range.finite == 0 {
         let _ = writeln!(
             out,
@@ -192,13 +199,76 @@ pub fn describe(name: &str, grid: &Grid, bins: usize) -> String {
             }
         }
     }
+    footer(&mut out, grid);
+    out
+}
+
+/// The first lines of every report: the file, its format, size, sample type and placement.
+fn header(name: &str, grid: &Grid) -> String {
+    let mut out = String::new();
+    let [nx, ny, nz] = grid.dims;
+    let [sx, sy, sz] = grid.spacing;
+    let [ox, oy, oz] = grid.origin;
+    // `fmt::Write` for `String` cannot fail.
+    let _ = writeln!(out, "{name}");
+    let _ = writeln!(out, "  format    {}", grid.format);
+    let _ = writeln!(
+        out,
+        "  dims      {nx} × {ny} × {nz} ({} samples)",
+        thousands(grid.len() as u64)
+    );
+    let _ = writeln!(out, "  dtype     {}", grid.samples.dtype().name());
+    if !grid.scale.is_identity() {
+        let _ = writeln!(
+            out,
+            "  rescale   value = {} × stored + {}",
+            grid.scale.slope, grid.scale.inter
+        );
+    }
+    let _ = writeln!(
+        out,
+        "  spacing   {} × {} × {}",
+        short(sx),
+        short(sy),
+        short(sz)
+    );
+    let _ = writeln!(
+        out,
+        "  origin    {}, {}, {}",
+        short(ox),
+        short(oy),
+        short(oz)
+    );
+    if let Some(frame) = grid.frame {
+        let d = frame.direction;
+        let axis = |a: usize| {
+            format!(
+                "({}, {}, {})",
+                short(d[0][a]),
+                short(d[1][a]),
+                short(d[2][a])
+            )
+        };
+        let _ = writeln!(
+            out,
+            "  axes      x → {}, y → {}, z → {} ({} world)",
+            axis(0),
+            axis(1),
+            axis(2),
+            frame.space.name()
+        );
+    }
+    out
+}
+
+/// The last lines of every report: what the reader noted and warned of.
+fn footer(out: &mut String, grid: &Grid) {
     for note in &grid.notes {
         let _ = writeln!(out, "  note      {note}");
     }
     for warning in &grid.warnings {
         let _ = writeln!(out, "  warning   {warning}");
     }
-    out
 }
 
 /// The usual CT surface levels, in Hounsfield units.

@@ -1,8 +1,10 @@
 //! Mesh writers, chosen by the output file's extension. Each writes to any `Write`; the caller
-//! puts a temporary file behind it (see [`crate::atomic`]).
+//! puts a temporary file behind it (see [`crate::atomic`]). The meshes of a label volume go to
+//! a directory, a file per label ([`LabelFiles`]), or to one `.glb` atlas ([`write_atlas`]).
 
 mod binary;
 mod glb;
+mod labels;
 mod obj;
 mod options;
 mod ply;
@@ -13,6 +15,8 @@ mod text;
 use std::io::{self, Write};
 use std::path::Path;
 
+pub use glb::write_atlas;
+pub use labels::{LabelFiles, LabelMesh};
 pub use options::WriteOptions;
 pub use slices::MeshSlices;
 
