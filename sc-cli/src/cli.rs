@@ -216,9 +216,27 @@ pub struct ExtractArgs {
     /// The surface value: samples `>= iso` are inside. Required for files (see `skelclimb info`).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_iso)]
     pub iso: Option<f64>,
-    /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format.
-    #[arg(short, long, value_parser = parse_output, required_unless_present = "shards")]
-    pub output: Option<Output>,
+    /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format. With
+    /// --labels, a .glb file holds every label as a named, coloured node, and a directory
+    /// (any other path) gets one file per label.
+    #[arg(short, long, required_unless_present = "shards")]
+    pub output: Option<PathBuf>,
+    /// Mesh a label volume (a segmentation, an atlas): every region at once, each a closed
+    /// mesh, neighbours sharing their interfaces exactly. `all` or a list such as `1,5,17-20`
+    /// chooses which labels get a mesh.
+    #[arg(long, value_name = "all|LIST", value_parser = sc_io::labels::Selection::parse,
+          conflicts_with_all = ["iso", "demo", "stream", "shards", "max_error", "pad"])]
+    pub labels: Option<sc_io::labels::Selection>,
+    /// With --labels: the label of no region, not meshed, and what lies outside the volume.
+    #[arg(long, requires = "labels", default_value_t = 0)]
+    pub background: u64,
+    /// With --labels: names and colours of the labels (ITK-SNAP, FreeSurfer or MRIcron
+    /// table) [default: a table beside the volume, such as aal.nii.txt and aal.nii.lut].
+    #[arg(long, requires = "labels", value_name = "FILE")]
+    pub label_table: Option<PathBuf>,
+    /// With --labels and a directory: the format of each label's file.
+    #[arg(long, requires = "labels", value_parser = parse_format, default_value = "ply")]
+    pub format: MeshFormat,
     /// Instead of one mesh file, write one shard per block of cubes into this directory (made
     /// if missing), plus `manifest.json`; `skelclimb merge` joins them into exactly the mesh
     /// `-o` would have written. The volume is read whole and the blocks meshed one after
@@ -414,9 +432,20 @@ pub struct Output {
 }
 
 fn parse_output(s: &str) -> Result<Output, String> {
-    let path = PathBuf::from(s);
-    let format = MeshFormat::from_path(&path)?;
-    Ok(Output { path, format })
+    Output::new(PathBuf::from(s))
+}
+
+impl Output {
+    /// A mesh file, its format told by its extension.
+    pub fn new(path: PathBuf) -> Result<Output, String> {
+        let format = MeshFormat::from_path(&path)?;
+        Ok(Output { path, format })
+    }
+}
+
+fn parse_format(s: &str) -> Result<MeshFormat, String> {
+    MeshFormat::from_path(std::path::Path::new(&format!("x.{s}")))
+        .map_err(|_| format!("{s:?} is not a mesh format: use ply, obj, stl or glb"))
 }
 
 fn parse_triple(s: &str) -> Result<[f64; 3], String> {

@@ -25,12 +25,16 @@ use sc_io::{Error, Result};
 /// path fails before a long read, and written whole or not at all.
 pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let options = args.read.read_options();
+    if args.labels.is_some() {
+        return super::labels::run(args, quiet);
+    }
     let format = check_input(args, &options)?;
     let output = match (&args.output, &args.shards) {
         (_, Some(dir)) => return shards(args, dir, &options, quiet),
-        (Some(output), None) => output,
+        (Some(path), None) => Output::new(path.clone()).map_err(Error::Usage)?,
         (None, None) => return Err(Error::Usage("give -o FILE or --shards DIR".into())),
     };
+    let output = &output;
     check_output(args, output)?;
     let mesh_file = AtomicFile::create(&output.path)?;
     let stats_file = args
@@ -297,7 +301,7 @@ fn write_mesh(
 }
 
 /// The volume read whole (or built in), its iso value, and its name for messages.
-fn load(
+pub(super) fn load(
     args: &ExtractArgs,
     options: &ReadOptions,
     progress: &dyn Progress,
@@ -357,7 +361,7 @@ fn shards(args: &ExtractArgs, dir: &Path, options: &ReadOptions, quiet: bool) ->
 
 /// About how many bytes `format` writes for `mesh`, for the progress bar: exact for binary PLY
 /// and STL up to the header, a fair guess for the text formats.
-fn approx_bytes(mesh: &Mesh, format: MeshFormat, ascii: bool) -> u64 {
+pub(super) fn approx_bytes(mesh: &Mesh, format: MeshFormat, ascii: bool) -> u64 {
     let v = mesh.positions.len() as u64;
     let n = mesh.normals.len() as u64;
     let t = mesh.triangles.len() as u64;
@@ -371,7 +375,7 @@ fn approx_bytes(mesh: &Mesh, format: MeshFormat, ascii: bool) -> u64 {
 }
 
 /// Refuses a run whose outputs would overwrite its input or each other.
-fn check_outputs(input: Option<&Path>, mesh: &Path, stats: Option<&Path>) -> Result<()> {
+pub(super) fn check_outputs(input: Option<&Path>, mesh: &Path, stats: Option<&Path>) -> Result<()> {
     let clash = |what: &str, a: &Path, b: &Path| -> Result<()> {
         if same_place(a, b) {
             return Err(Error::Usage(format!(

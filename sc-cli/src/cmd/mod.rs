@@ -2,6 +2,7 @@
 
 pub mod extract;
 pub mod info;
+pub mod labels;
 pub mod merge;
 pub mod table1;
 

@@ -14,7 +14,10 @@
 //! [`LabelTable::merge`]s them. [`file_stem`] names a label's mesh file, [`default_rgb`] colours
 //! a label no table colours.
 
+mod mesh;
 mod parse;
+
+pub use mesh::{LabelMeshes, LabelRequest, Selection, extract};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

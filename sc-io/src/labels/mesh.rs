@@ -1,0 +1,197 @@
+//! The bridge from a typed [`Grid`] of labels to the runtime's label sweep: one closed mesh per
+//! label, placed in world units like a scan's surface.
+
+use std::ops::RangeInclusive;
+
+use sc_runtime::labels::{Label as Sample, LabelParams, extract_labels};
+use sc_runtime::{Mesh, Mode, Stats, Volume};
+
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::space::{Coordinates, World};
+use crate::volume::{Grid, Samples};
+
+/// Which labels get a mesh.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Selection {
+    /// Every label present but the background.
+    All,
+    /// The labels in these ranges; each must be present.
+    Only(Vec<RangeInclusive<u64>>),
+}
+
+impl Selection {
+    /// Parses `all` or a list like `1,5,17-20`, for `--labels`.
+    pub fn parse(text: &str) -> std::result::Result<Selection, String> {
+        if text.trim() == "all" {
+            return Ok(Selection::All);
+        }
+        let id = |s: &str| {
+            s.trim()
+                .parse::<u64>()
+                .map_err(|_| format!("{s:?} is not a label id (a whole number, 0 or more)"))
+        };
+        let ranges = text
+            .split(',')
+            .map(|part| match part.split_once('-') {
+                Some((a, b)) => {
+                    let (a, b) = (id(a)?, id(b)?);
+                    if a > b {
+                        return Err(format!("{part:?}: the range runs backwards"));
+                    }
+                    Ok(a..=b)
+                }
+                None => id(part).map(|a| a..=a),
+            })
+            .collect::<std::result::Result<Vec<_>, _>>()?;
+        Ok(Selection::Only(ranges))
+    }
+
+    fn contains(&self, id: u64) -> bool {
+        match self {
+            Selection::All => true,
+            Selection::Only(ranges) => ranges.iter().any(|r| r.contains(&id)),
+        }
+    }
+}
+
+/// What to mesh in a label volume.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelRequest {
+    /// The label of no region: not meshed, and what lies outside the volume.
+    pub background: u64,
+    /// Which steps run.
+    pub mode: Mode,
+    /// Whether to compute normals.
+    pub normals: bool,
+    /// Worker threads, 0 for all cores.
+    pub threads: usize,
+    /// Which coordinates the meshes are in.
+    pub coordinates: Coordinates,
+    /// Which labels get a mesh.
+    pub selection: Selection,
+}
+
+/// One closed mesh per label selected, ascending by label.
+#[derive(Clone, Debug, Default)]
+pub struct LabelMeshes {
+    /// Each label with its mesh.
+    pub meshes: Vec<(u64, Mesh)>,
+    /// The atlas's counts: each interface once.
+    pub stats: Stats,
+}
+
+/// Meshes the labels `request` selects in `grid`: an integer volume, read as stored.
+pub fn extract(grid: &Grid, request: &LabelRequest, progress: &dyn Progress) -> Result<LabelMeshes> {
+    if !grid.scale.is_identity() {
+        return Err(Error::Usage(format!(
+            "--labels: the volume rescales its samples (slope {}, intercept {}); labels are \
+             read as stored integers, and a rescaled volume is a scan: give --iso instead",
+            grid.scale.slope, grid.scale.inter
+        )));
+    }
+    let world = World::new(grid.frame, grid.origin, request.coordinates);
+    progress.phase("meshing labels", grid.dims[2].saturating_sub(1) as u64);
+    let mut out = match &grid.samples {
+        Samples::U8(v) => typed(v, grid, request, &world),
+        Samples::I8(v) => {
+            let wide: Vec<i16> = v.iter().map(|&l| i16::from(l)).collect();
+            typed(&wide, grid, request, &world)
+        }
+        Samples::U16(v) => typed(v, grid, request, &world),
+        Samples::I16(v) => typed(v, grid, request, &world),
+        Samples::U32(v) => typed(v, grid, request, &world),
+        Samples::I32(v) => typed(v, grid, request, &world),
+        Samples::F32(_) | Samples::F64(_) => Err(Error::Usage(format!(
+            "--labels: the volume holds {} samples; label volumes hold integers (give --iso to \
+             mesh a scan)",
+            grid.samples.dtype().name()
+        ))),
+    }?;
+    for (_, mesh) in &mut out.meshes {
+        if !world.is_translation() {
+            world.place(mesh);
+        }
+    }
+    Ok(out)
+}
+
+/// [`extract`] for one sample type.
+fn typed<L>(data: &[L], grid: &Grid, request: &LabelRequest, world: &World) -> Result<LabelMeshes>
+where
+    L: Sample + TryFrom<u64> + TryInto<i64>,
+{
+    let name = grid.samples.dtype().name();
+    let background = L::try_from(request.background).map_err(|_| {
+        Error::Usage(format!("--background {} does not fit the volume's {name} samples", request.background))
+    })?;
+    let params = LabelParams {
+        background,
+        mode: request.mode,
+        pad: true,
+        spacing: grid.spacing,
+        origin: if world.is_translation() { world.offset } else { [0.0; 3] },
+        threads: request.threads,
+        ..LabelParams::default()
+    };
+    let volume = Volume::new(data, grid.dims)?;
+    let atlas = extract_labels(volume, &params)?;
+    let present = atlas.labels(background);
+    let id = |l: L| -> Option<u64> { l.try_into().ok().and_then(|v: i64| u64::try_from(v).ok()) };
+    if let Some(&negative) = present.iter().find(|&&l| id(l).is_none()) {
+        return Err(Error::Usage(format!(
+            "--labels: the volume holds the label {negative:?}; label ids are whole numbers, 0 or more"
+        )));
+    }
+    let chosen: Vec<L> = present
+        .iter()
+        .copied()
+        .filter(|&l| id(l).is_some_and(|i| request.selection.contains(i)))
+        .collect();
+    if let Selection::Only(ranges) = &request.selection {
+        let missing: Vec<String> = ranges
+            .iter()
+            .filter(|r| !present.iter().any(|&l| id(l).is_some_and(|i| r.contains(&i))))
+            .map(|r| if r.start() == r.end() { r.start().to_string() } else { format!("{}-{}", r.start(), r.end()) })
+            .collect();
+        if !missing.is_empty() {
+            let some: Vec<String> = present.iter().take(12).filter_map(|&l| id(l)).map(|i| i.to_string()).collect();
+            return Err(Error::Usage(format!(
+                "--labels: no sample holds {} (present: {}{})",
+                missing.join(", "),
+                some.join(", "),
+                if present.len() > some.len() { ", …" } else { "" }
+            )));
+        }
+    }
+    if chosen.is_empty() {
+        return Err(Error::Usage(format!(
+            "--labels: the volume holds no label besides the background {}",
+            request.background
+        )));
+    }
+    let meshes = atlas
+        .meshes(&chosen, request.normals)
+        .into_iter()
+        .filter_map(|(l, mesh)| Some((id(l)?, mesh)))
+        .collect();
+    Ok(LabelMeshes { meshes, stats: atlas.stats })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Selection;
+
+    #[test]
+    fn selections_parse_or_say_why_not() {
+        assert_eq!(Selection::parse("all"), Ok(Selection::All));
+        assert_eq!(
+            Selection::parse("1,5,17-20"),
+            Ok(Selection::Only(vec![1..=1, 5..=5, 17..=20]))
+        );
+        for bad in ["", "1,,2", "x", "-3", "5-2", "1.5", "all,3"] {
+            assert!(Selection::parse(bad).is_err(), "{bad:?}");
+        }
+        assert!(Selection::parse("5-2").unwrap_err().contains("backwards"));
+    }
+}
