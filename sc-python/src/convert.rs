@@ -10,44 +10,37 @@ use pyo3::prelude::*;
 /// The runtime's sample types, in the order error messages list them.
 pub const TYPES: &str = "uint8, int8, uint16, int16, uint32, int32, float32 or float64";
 
-/// Calls `$body` with `$t` bound to the Rust type of `$array`'s dtype, or returns a `TypeError`.
-macro_rules! with_element {
-    ($py:expr, $array:expr, $name:expr, $t:ident => $body:expr) => {{
+/// Calls `$body` with `$t` bound to the Rust type of `$array`'s dtype among `[$ty, ...]`, or
+/// returns a `TypeError` that names `$array` and lists `$names`.
+macro_rules! with_type {
+    ($py:expr, $array:expr, $name:expr, $names:expr, [$($ty:ty),+], $t:ident => $body:expr) => {{
         let dtype = numpy::PyUntypedArrayMethods::dtype($array);
         let is = |other| numpy::PyArrayDescrMethods::is_equiv_to(&dtype, &other);
-        if is(numpy::dtype::<u8>($py)) {
-            type $t = u8;
+        $(if is(numpy::dtype::<$ty>($py)) {
+            type $t = $ty;
             $body
-        } else if is(numpy::dtype::<i8>($py)) {
-            type $t = i8;
-            $body
-        } else if is(numpy::dtype::<u16>($py)) {
-            type $t = u16;
-            $body
-        } else if is(numpy::dtype::<i16>($py)) {
-            type $t = i16;
-            $body
-        } else if is(numpy::dtype::<u32>($py)) {
-            type $t = u32;
-            $body
-        } else if is(numpy::dtype::<i32>($py)) {
-            type $t = i32;
-            $body
-        } else if is(numpy::dtype::<f32>($py)) {
-            type $t = f32;
-            $body
-        } else if is(numpy::dtype::<f64>($py)) {
-            type $t = f64;
-            $body
-        } else {
+        } else)+ {
             Err(pyo3::exceptions::PyTypeError::new_err(format!(
                 "{}: unsupported dtype {}; use {}",
-                $name,
-                dtype,
-                $crate::convert::TYPES
+                $name, dtype, $names
             )))
         }
     }};
+}
+pub(crate) use with_type;
+
+/// [`with_type`] over the runtime's sample types ([`TYPES`]).
+macro_rules! with_element {
+    ($py:expr, $array:expr, $name:expr, $t:ident => $body:expr) => {
+        $crate::convert::with_type!(
+            $py,
+            $array,
+            $name,
+            $crate::convert::TYPES,
+            [u8, i8, u16, i16, u32, i32, f32, f64],
+            $t => $body
+        )
+    };
 }
 pub(crate) use with_element;
 
@@ -92,11 +85,11 @@ pub fn samples<'a, T: Element>(
     Ok(typed.readonly())
 }
 
-/// A `(n, 3)` NumPy array that takes over `rows` without copying them.
-pub fn rows<'py, T: Element>(
+/// A `(n, N)` NumPy array that takes over `rows` without copying them.
+pub fn rows<'py, T: Element, const N: usize>(
     py: Python<'py>,
-    rows: Vec<[T; 3]>,
+    rows: Vec<[T; N]>,
 ) -> PyResult<Bound<'py, PyArray2<T>>> {
     let n = rows.len();
-    PyArray1::from_vec(py, rows.into_flattened()).reshape([n, 3])
+    PyArray1::from_vec(py, rows.into_flattened()).reshape([n, N])
 }

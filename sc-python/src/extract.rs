@@ -34,6 +34,49 @@ fn bound(bound: Option<(f64, String)>) -> PyResult<Option<ErrorBound>> {
     Ok(Some(ErrorBound::new(d, units)))
 }
 
+/// A spacing (three positive numbers) and an origin, checked.
+fn grid(spacing: [f64; 3], origin: [f64; 3]) -> PyResult<([f64; 3], [f64; 3])> {
+    let spacing = arguments::triple("spacing", spacing)?;
+    if !spacing.iter().all(|s| *s > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "spacing: must be three positive numbers, got {spacing:?}"
+        )));
+    }
+    Ok((spacing, arguments::triple("origin", origin)?))
+}
+
+/// Where the samples sit: `(spacing, origin, world)`, the extractor working at
+/// `index × spacing + origin` and `world` then mapping its vertices, unless it is a translation
+/// (then already the origin). From the top three rows of an `affine` if given, as the CLI places
+/// a file's mesh, otherwise from `spacing` and `origin`; both checked.
+pub fn placement(
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    affine: Option<[[f64; 4]; 3]>,
+    space: Option<&str>,
+) -> PyResult<([f64; 3], [f64; 3], World)> {
+    let space = world::space(space)?;
+    let (spacing, world) = match affine {
+        Some(rows) => world::from_affine(rows, space)?,
+        None => (
+            spacing,
+            World {
+                space,
+                ..world::translation(origin)
+            },
+        ),
+    };
+    // As the CLI does: a translation is the extractor's origin (the same f32 arithmetic), any
+    // other map is applied to the finished mesh.
+    let origin = if world.is_translation() {
+        world.offset
+    } else {
+        [0.0; 3]
+    };
+    let (spacing, origin) = grid(spacing, origin)?;
+    Ok((spacing, origin, world))
+}
+
 /// Checks the numbers every front end takes and builds the runtime's parameters.
 pub fn params(
     level: f64,
@@ -48,13 +91,7 @@ pub fn params(
             "level: must be a finite number, got {level}"
         )));
     }
-    let spacing = arguments::triple("spacing", spacing)?;
-    if !spacing.iter().all(|s| *s > 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "spacing: must be three positive numbers, got {spacing:?}"
-        )));
-    }
-    let origin = arguments::triple("origin", origin)?;
+    let (spacing, origin) = grid(spacing, origin)?;
     Ok(Params {
         mode: mode(mode_name)?,
         max_error: bound(max_error)?,
@@ -86,24 +123,7 @@ pub fn extract<'py>(
     space: Option<&str>,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
     let threads = arguments::threads(threads)?;
-    let space = world::space(space)?;
-    let (spacing, world) = match affine {
-        Some(rows) => world::from_affine(rows, space)?,
-        None => (
-            spacing,
-            World {
-                space,
-                ..world::translation(origin)
-            },
-        ),
-    };
-    // As the CLI does: a translation is the extractor's origin (the same f32 arithmetic), any
-    // other map is applied to the finished mesh.
-    let origin = if world.is_translation() {
-        world.offset
-    } else {
-        [0.0; 3]
-    };
+    let (spacing, origin, world) = placement(spacing, origin, affine, space)?;
     let params = params(level, spacing, origin, mode, normals, max_error)?;
     let dims = convert::dims(volume, "volume")?;
     let mut mesh =
@@ -158,15 +178,23 @@ pub fn stats<'py>(
     dims: [usize; 3],
     space: Option<Space>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let counts = |v: u64, t: u64| -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("dims", dims)?;
+    d.set_item("iso", level)?;
+    report(&d, s, mode, space)?;
+    Ok(d)
+}
+
+/// Adds to `d` the mode, the world convention and the runtime's figures ([`Stats::report`]),
+/// under the names every front end gives them.
+pub fn report(d: &Bound<'_, PyDict>, s: &Stats, mode: &str, space: Option<Space>) -> PyResult<()> {
+    let py = d.py();
+    let counts = |v: u64, t: u64| -> PyResult<Bound<'_, PyDict>> {
         let d = PyDict::new(py);
         d.set_item("vertices", v)?;
         d.set_item("triangles", t)?;
         Ok(d)
     };
-    let d = PyDict::new(py);
-    d.set_item("dims", dims)?;
-    d.set_item("iso", level)?;
     d.set_item("mode", mode)?;
     d.set_item("space", space.map(Space::name))?;
     for (name, figure) in s.report() {
@@ -178,6 +206,5 @@ pub fn stats<'py>(
             Figure::Edges(n) => d.set_item(name, n)?,
         }
     }
-    d.set_item("reduction_percent", s.reduction_percent())?;
-    Ok(d)
+    d.set_item("reduction_percent", s.reduction_percent())
 }

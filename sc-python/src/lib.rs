@@ -8,6 +8,7 @@ mod convert;
 mod errors;
 mod extract;
 mod files;
+mod labels;
 mod recycle;
 mod shards;
 mod skimage;
@@ -29,6 +30,7 @@ fn release_memory() -> usize {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(extract::extract, m)?)?;
+    m.add_function(wrap_pyfunction!(labels::labels, m)?)?;
     m.add_function(wrap_pyfunction!(skimage::skimage_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(files::save, m)?)?;
     m.add_function(wrap_pyfunction!(files::load, m)?)?;

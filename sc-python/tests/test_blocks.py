@@ -46,7 +46,7 @@ def same(a, b):
 
 
 def test_docstring_examples_run():
-    for module in (skelclimb, skelclimb._blocks, skelclimb.dask):
+    for module in (skelclimb, skelclimb._blocks, skelclimb._labels, skelclimb.dask):
         failed, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
         assert failed == 0, module.__name__
         assert tried > 0, module.__name__

@@ -299,20 +299,32 @@ def test_pad_closes_the_surface():
 def test_no_copy_of_the_input():
     vol = np.zeros((512, 512, 512), np.uint8)
     vol[100:400, 100:400, 100:400] = 255
-    tracemalloc.start()
-    before = tracemalloc.get_traced_memory()[0]
-    tracemalloc.reset_peak()
-    m = skelclimb.extract(vol, 128, normals=False)
-    peak = tracemalloc.get_traced_memory()[1] - before
-    tracemalloc.stop()
+    m, peak = traced_peak(lambda: skelclimb.extract(vol, 128, normals=False))
     assert len(m.faces) > 0
     # The mesh's arrays are handed over, so they count; a copy of the volume (128 MiB) would too.
     mesh_bytes = m.vertices.nbytes + m.faces.nbytes
     assert peak < mesh_bytes + vol.nbytes // 16, (peak, mesh_bytes)
 
 
+def traced_peak(call):
+    """`call()`'s result, and the peak of the memory NumPy and Python allocated during it."""
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    tracemalloc.reset_peak()
+    try:
+        result = call()
+        return result, tracemalloc.get_traced_memory()[1] - before
+    finally:
+        tracemalloc.stop()
+
+
 def test_the_gil_is_released_during_extraction():
     vol = np.random.default_rng(1).random((110, 110, 110), dtype=np.float32)
+    assert_gil_released(lambda: skelclimb.extract(vol, 0.5, threads=1))
+
+
+def assert_gil_released(call):
+    """A Python thread keeps counting while `call()` runs (it must take over 50 ms)."""
     counter = [0]
     done = threading.Event()
 
@@ -327,7 +339,7 @@ def test_the_gil_is_released_during_extraction():
         time.sleep(0.1)
         rate = (counter[0] - first) / (time.perf_counter() - start)
         start, first = time.perf_counter(), counter[0]
-        skelclimb.extract(vol, 0.5, threads=1)
+        call()
         during = counter[0] - first
         elapsed = time.perf_counter() - start
     finally:

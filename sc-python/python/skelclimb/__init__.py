@@ -7,7 +7,7 @@
 >>> mesh.faces.shape[0] < mesh.stats["steps123"]["triangles"]
 True
 
-Two entry points:
+Three entry points:
 
 * :func:`extract` is this package's own call: vertices in ``(x, y, z)`` order, where ``x`` is the
   fastest-varying axis in memory (the last axis of a C-ordered array), spacing and origin in the
@@ -15,6 +15,8 @@ Two entry points:
   :func:`load` returns, the vertices land in the scanner's world, where the command puts them.
 * :func:`marching_cubes` is a drop-in for ``skimage.measure.marching_cubes``: vertices in the
   array's own axis order, the same winding, the same return value.
+* :func:`labels` meshes every region of an integer label volume (a segmentation) in one sweep:
+  a closed :class:`Mesh` per label, and an :class:`Atlas` holding each interface once.
 """
 
 from __future__ import annotations
@@ -27,13 +29,16 @@ import numpy as np
 from . import _native
 
 __all__ = [
+    "Atlas",
     "BlockMesh",
+    "Labels",
     "Mesh",
     "Scan",
     "SliceStreamer",
     "block_samples",
     "extract",
     "extract_block",
+    "labels",
     "load",
     "marching_cubes",
     "merge_shards",
@@ -247,6 +252,20 @@ def _affine(affine, spacing, origin):
     return affine
 
 
+def _placement(affine, spacing, origin):
+    """``(affine, spacing, origin)`` checked, with the defaults filled in: the affine as
+    :func:`_affine` gives it (or None), the spacing ``(1, 1, 1)`` and the origin zero."""
+    affine = _affine(affine, spacing, origin)
+    spacing = _triple((1, 1, 1) if spacing is None else spacing, "spacing")
+    origin = _triple((0, 0, 0) if origin is None else origin, "origin")
+    return affine, spacing, origin
+
+
+def _mode(mode):
+    if mode not in _MODES:
+        raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
+
+
 def extract(
     volume,
     level,
@@ -330,11 +349,8 @@ def extract(
     """
     volume = _volume(volume)
     level = _level(level)
-    affine = _affine(affine, spacing, origin)
-    spacing = _triple((1, 1, 1) if spacing is None else spacing, "spacing")
-    origin = _triple((0, 0, 0) if origin is None else origin, "origin")
-    if mode not in _MODES:
-        raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
+    affine, spacing, origin = _placement(affine, spacing, origin)
+    _mode(mode)
     threads = _native.threads(threads)
     if pad:
         volume, order = _pad(volume, level)
@@ -427,8 +443,7 @@ class SliceStreamer:
             raise ValueError(f"shape: expected (nz, ny, nx), got {shape!r}")
         if max(shape) >= 2**64:
             raise MemoryError(f"shape: streaming a volume of shape {shape} is beyond any memory")
-        if mode not in _MODES:
-            raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
+        _mode(mode)
         self._native = _native.SliceStreamer(
             shape, _level(level), _triple(spacing, "spacing"), _triple(origin, "origin"), mode,
             bool(normals),
@@ -485,4 +500,5 @@ def release_memory():
 
 
 from ._blocks import BlockMesh, block_samples, extract_block  # noqa: E402  (needs Mesh above)
+from ._labels import Atlas, Labels, labels  # noqa: E402  (needs Mesh and the checks above)
 from ._skimage import marching_cubes  # noqa: E402  (needs extract above)

@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Literal, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Iterable, Iterator, List, Literal, Mapping, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -57,6 +57,40 @@ def marching_cubes(
     npt.NDArray[np.float32],
     npt.NDArray[np.float32],
 ]: ...
+class Atlas:
+    vertices: npt.NDArray[np.float32]
+    faces: npt.NDArray[np.uint32]
+    face_labels: npt.NDArray[np.integer[Any]]
+    def __init__(
+        self,
+        vertices: npt.NDArray[np.float32],
+        faces: npt.NDArray[np.uint32],
+        face_labels: npt.NDArray[np.integer[Any]],
+    ) -> None: ...
+
+class Labels(Mapping[int, Mesh]):
+    atlas: Atlas
+    stats: dict[str, Any]
+    def __getitem__(self, label: int) -> Mesh: ...
+    def __iter__(self) -> Iterator[int]: ...
+    def __len__(self) -> int: ...
+    def labels(self) -> List[int]: ...
+    def to_pyvista(self) -> Any: ...
+
+def labels(
+    volume: npt.NDArray[np.integer[Any]],
+    *,
+    affine: Optional[npt.ArrayLike] = ...,
+    space: _Space = ...,
+    spacing: Optional[_Triple] = ...,
+    origin: Optional[_Triple] = ...,
+    labels: Optional[Iterable[int]] = ...,
+    background: int = ...,
+    mode: _Mode = ...,
+    pad: bool = ...,
+    normals: bool = ...,
+) -> Labels: ...
+
 class Scan(NamedTuple):
     volume: npt.NDArray[Any]
     affine: npt.NDArray[np.float64]

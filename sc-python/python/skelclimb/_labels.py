@@ -1,0 +1,220 @@
+"""Label volumes: every region of a segmentation meshed in one sweep (``docs/labels.md``)."""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Mapping
+
+import numpy as np
+
+from . import Mesh, _index, _mode, _native, _placement, _volume
+
+# The label types the runtime sweeps as they are, smallest first: a volume of another integer
+# type is converted to the first of them that holds its values and the background.
+_LABEL_TYPES = tuple(np.dtype(t) for t in ("u1", "i2", "u2", "i4", "u4", "u8"))
+
+
+class Atlas:
+    """The surfaces between the regions of a label volume, each interface once.
+
+    Attributes
+    ----------
+    vertices : (V, 3) float32 array
+        Positions, ``(x, y, z)``, as :func:`skelclimb.extract` places them. A vertex on an
+        interface exists once, shared by the meshes of the labels on both sides.
+    faces : (T, 3) uint32 array
+        Vertex indices, wound so that ``(b - a) × (c - a)`` points from ``face_labels[t, 0]``
+        to ``face_labels[t, 1]``.
+    face_labels : (T, 2) array of the volume's dtype
+        Per triangle, the label it faces away from, then the label it faces toward. The
+        background is a label here like any other.
+    """
+
+    __slots__ = ("vertices", "faces", "face_labels")
+
+    def __init__(self, vertices, faces, face_labels):
+        self.vertices = vertices
+        self.faces = faces
+        self.face_labels = face_labels
+
+    def __repr__(self):
+        return f"Atlas({len(self.vertices)} vertices, {len(self.faces)} triangles)"
+
+
+class Labels(Mapping):
+    """The meshes of a label volume's regions, from :func:`labels`.
+
+    A mapping from label (a Python ``int``) to that label's closed :class:`Mesh`, in ascending
+    order of label: ``result[7]``, ``len(result)``, ``for label in result``, ``result.items()``.
+
+    Attributes
+    ----------
+    atlas : Atlas
+        The shared vertices, the triangles and their two labels; each label's mesh is its
+        atlas triangles with that label first, plus those with it second, turned over.
+    stats : dict
+        As :attr:`Mesh.stats` for the whole atlas (``steps123``, ``result``, ``merged``,
+        ``blocked``, ``bounded``, ``reduction_percent``, ``mode``, ``dims``, ``space``), and
+        ``background``.
+    """
+
+    __slots__ = ("_meshes", "atlas", "stats")
+
+    def __init__(self, meshes, atlas, stats):
+        self._meshes = meshes
+        self.atlas = atlas
+        self.stats = stats
+
+    def __getitem__(self, label):
+        try:
+            return self._meshes[operator.index(label)]
+        except (TypeError, KeyError):
+            shown = ", ".join(map(str, list(self._meshes)[:10]))
+            more = ", …" if len(self._meshes) > 10 else ""
+            raise KeyError(
+                f"label {label!r} has no mesh here; meshed: {shown or 'none'}{more}"
+            ) from None
+
+    def __iter__(self):
+        return iter(self._meshes)
+
+    def __len__(self):
+        return len(self._meshes)
+
+    def __repr__(self):
+        return f"Labels({len(self)} labels, {self.atlas!r})"
+
+    def labels(self):
+        """The labels meshed, ascending."""
+        return list(self._meshes)
+
+    def to_pyvista(self):
+        """The meshes as a ``pyvista.MultiBlock``, one block per label, named by the label
+        (needs the ``pyvista`` package)."""
+        import pyvista
+
+        blocks = pyvista.MultiBlock()
+        for label, mesh in self._meshes.items():
+            blocks.append(mesh.to_pyvista(), str(label))
+        return blocks
+
+
+def _label_volume(volume, background):
+    """``volume`` as a 3-D array of a label type the native code borrows, and its own dtype."""
+    if isinstance(volume, np.ndarray) and volume.dtype.kind not in "iu":
+        raise TypeError(
+            f"volume holds {volume.dtype}; label volumes need integers "
+            "(uint8, uint16, uint32, uint64, int16, int32; other integer types are converted)"
+        )
+    volume = _volume(volume)
+    dtype = volume.dtype
+    info = np.iinfo(dtype)
+    if not info.min <= background <= info.max:
+        raise ValueError(f"background: {background} is not a value of the volume's {dtype}")
+    if dtype in _LABEL_TYPES:
+        return volume, dtype
+    low = min(int(volume.min()), background) if volume.size else background
+    high = max(int(volume.max()), background) if volume.size else background
+    for target in _LABEL_TYPES:
+        t = np.iinfo(target)
+        if t.min <= low and high <= t.max:
+            # astype keeps the memory order, so the axes read the same.
+            return volume.astype(target), dtype
+    raise ValueError(
+        f"volume: its {dtype} labels run from {low} to {high}, which no label type holds "
+        "(uint8, uint16, uint32, uint64, int16, int32)"
+    )
+
+
+def _selection(labels):
+    """The labels asked for, as Python ints, or None for all."""
+    if labels is None:
+        return None
+    if isinstance(labels, (str, bytes, bytearray)):
+        raise TypeError(f"labels: expected an iterable of whole numbers, got {labels!r}")
+    try:
+        items = iter(labels)
+    except TypeError:
+        raise TypeError(f"labels: expected an iterable of whole numbers, got {labels!r}") from None
+    return sorted({_index(v, "labels") for v in items})
+
+
+def labels(
+    volume,
+    *,
+    affine=None,
+    space=None,
+    spacing=None,
+    origin=None,
+    labels=None,
+    background=0,
+    mode="embedded",
+    pad=True,
+    normals=True,
+):
+    """Meshes every region of a label volume in one sweep: a closed mesh per label, whose
+    neighbours share their interfaces exactly.
+
+    Parameters
+    ----------
+    volume : 3-D integer ndarray
+        One region per value. Its axes, ``affine``, ``space``, ``spacing`` and ``origin`` are
+        read as :func:`skelclimb.extract` reads them: a C-ordered array of shape
+        ``(nz, ny, nx)`` or a Fortran-ordered one of shape ``(nx, ny, nz)``. uint8, uint16,
+        uint32, uint64, int16 and int32 are used **without copying** when contiguous; other
+        integer types (int8, int64) are converted to the smallest of those that holds every
+        value and the background (a ``ValueError`` if none does). Float and bool arrays are a
+        ``TypeError``: labels are integers.
+    affine, space, spacing, origin
+        Where the samples sit, exactly as for :func:`skelclimb.extract`.
+    labels : iterable of int, optional
+        The labels to mesh; each must have a surface in the volume (a ``ValueError`` lists some
+        that do). By default every label but the background.
+    background : int
+        The label of "no region" (default 0): never meshed, and what lies outside the volume.
+    mode : ``"embedded"`` (default), ``"paper"`` or ``"steps123"``
+        ``embedded`` merges grey edges only where every label's surface stays a closed
+        2-manifold, ``paper`` wherever the four cubes around an edge hold two labels,
+        ``steps123`` nowhere.
+    pad : bool
+        Surround the volume with background (default, without a copy), so every label's mesh
+        is closed where it touches the volume's border.
+    normals : bool
+        Per-vertex normals of each label's mesh, pointing out of the label (area-weighted).
+
+    Returns
+    -------
+    Labels
+        ``result[label]`` is that label's :class:`Mesh`; ``result.atlas`` holds every interface
+        once. The GIL is released while the meshes are built (one thread).
+
+    Examples
+    --------
+    >>> import numpy as np, skelclimb
+    >>> v = np.zeros((6, 6, 8), np.uint8); v[1:5, 1:5, 1:4] = 1; v[1:5, 1:5, 4:7] = 2
+    >>> result = skelclimb.labels(v)
+    >>> result.labels()
+    [1, 2]
+
+    The interface between 1 and 2 is in the atlas once, and in both meshes:
+
+    >>> between = int(np.isin(result.atlas.face_labels, [1, 2]).all(axis=1).sum())
+    >>> len(result[1].faces) + len(result[2].faces) == len(result.atlas.faces) + between > 0
+    True
+    """
+    background = _index(background, "background")
+    volume, dtype = _label_volume(volume, background)
+    selection = _selection(labels)
+    affine, spacing, origin = _placement(affine, spacing, origin)
+    _mode(mode)
+    verts, faces, face_labels, meshes, stats = _native.labels(
+        volume, spacing, origin, background, mode, bool(pad), bool(normals), selection,
+        None if affine is None else affine[:3].tolist(), space,
+    )
+    if face_labels.dtype != dtype:
+        face_labels = face_labels.astype(dtype)
+    return Labels(
+        {label: Mesh(v, f, n, s) for label, v, f, n, s in meshes},
+        Atlas(verts, faces, face_labels),
+        stats,
+    )

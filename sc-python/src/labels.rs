@@ -1,0 +1,226 @@
+//! `skelclimb._native.labels`: a label volume's atlas and the meshes of the labels asked for,
+//! with the GIL released while either is built. The Python layer (`_labels.py`) converts the
+//! integer types the runtime does not take and wraps the arrays.
+
+use std::fmt::Display;
+
+use numpy::{Element, PyUntypedArray};
+use pyo3::conversion::FromPyObjectOwned;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use sc_io::space::World;
+use sc_runtime::labels::{Atlas, Label, LabelParams, extract_labels};
+use sc_runtime::{Mesh, Volume};
+
+use crate::convert::{self, with_type};
+use crate::{errors, extract};
+
+/// The label types, in the order error messages list them.
+pub const TYPES: &str = "uint8, uint16, uint32, uint64, int16 or int32";
+
+/// How many labels an error message lists before it only counts them.
+const LISTED: usize = 10;
+
+/// Meshes the regions of a contiguous 3-D integer array (axes, `spacing`, `origin`, `affine` and
+/// `space` as `extract` reads them). `selection`: the labels to mesh, each one with a surface,
+/// or every label but the background. Returns `(vertices, faces, face_labels, meshes, stats)`:
+/// the atlas, then `(label, vertices, faces, normals or None, stats)` per label meshed, ascending.
+#[pyfunction]
+#[pyo3(signature = (volume, spacing, origin, background, mode, pad, normals, selection=None, affine=None, space=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn labels<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, PyUntypedArray>,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    background: Bound<'py, PyAny>,
+    mode: &str,
+    pad: bool,
+    normals: bool,
+    selection: Option<Vec<Bound<'py, PyAny>>>,
+    affine: Option<[[f64; 4]; 3]>,
+    space: Option<&str>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let (spacing, origin, world) = extract::placement(spacing, origin, affine, space)?;
+    let request = Request {
+        dims: convert::dims(volume, "volume")?,
+        spacing,
+        origin,
+        world,
+        background,
+        mode,
+        pad,
+        normals,
+        selection,
+    };
+    with_type!(py, volume, "volume", TYPES, [u8, u16, u32, u64, i16, i32], L => {
+        run::<L>(py, volume, request)
+    })
+}
+
+/// The arguments of [`labels`], checked but for the background, which needs the label type.
+struct Request<'a, 'py> {
+    dims: [usize; 3],
+    spacing: [f64; 3],
+    origin: [f64; 3],
+    world: World,
+    background: Bound<'py, PyAny>,
+    mode: &'a str,
+    pad: bool,
+    normals: bool,
+    selection: Option<Vec<Bound<'py, PyAny>>>,
+}
+
+fn run<'py, L>(
+    py: Python<'py>,
+    volume: &Bound<'py, PyUntypedArray>,
+    request: Request<'_, 'py>,
+) -> PyResult<Bound<'py, PyTuple>>
+where
+    L: Label + Element + Display + FromPyObjectOwned<'py> + IntoPyObject<'py>,
+{
+    let Request {
+        dims,
+        spacing,
+        origin,
+        world,
+        background,
+        mode: mode_name,
+        pad,
+        normals,
+        selection,
+    } = request;
+    let dtype = numpy::dtype::<L>(py);
+    let background = background.extract::<L>().map_err(|_| {
+        PyValueError::new_err(format!(
+            "background: {background} is not a value of the volume's type ({dtype})"
+        ))
+    })?;
+    let params = LabelParams {
+        background,
+        mode: extract::mode(mode_name)?,
+        pad,
+        spacing,
+        origin,
+        ..LabelParams::default()
+    };
+    let mut atlas = {
+        let samples = convert::samples::<L>(volume, "volume")?;
+        let data = samples
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("volume: the array is not contiguous"))?;
+        let volume = Volume::new(data, dims).map_err(errors::runtime)?;
+        py.detach(|| extract_labels(volume, &params))
+            .map_err(errors::runtime)?
+    };
+    if !world.is_translation() {
+        py.detach(|| place(&world, &mut atlas));
+    }
+    let chosen = choose(&atlas.labels(background), background, selection)?;
+    let meshes = py.detach(|| atlas.meshes(&chosen, normals));
+
+    let stats = PyDict::new(py);
+    stats.set_item("dims", dims)?;
+    stats.set_item("background", background)?;
+    extract::report(&stats, &atlas.stats, mode_name, world.space)?;
+    let per_label = meshes
+        .into_iter()
+        .map(|(label, mesh)| {
+            let counts = PyDict::new(py);
+            counts.set_item("vertices", mesh.stats.vertices)?;
+            counts.set_item("triangles", mesh.stats.triangles)?;
+            let s = PyDict::new(py);
+            s.set_item("label", label)?;
+            s.set_item("mode", mode_name)?;
+            s.set_item("space", world.space.map(|s| s.name()))?;
+            s.set_item("result", counts)?;
+            let vertex_normals = match normals {
+                true => Some(convert::rows(py, mesh.normals)?),
+                false => None,
+            };
+            (
+                label,
+                convert::rows(py, mesh.positions)?,
+                convert::rows(py, mesh.triangles)?,
+                vertex_normals,
+                s,
+            )
+                .into_pyobject(py)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    (
+        convert::rows(py, atlas.positions)?,
+        convert::rows(py, atlas.triangles)?,
+        convert::rows(py, atlas.pairs)?,
+        per_label,
+        stats,
+    )
+        .into_pyobject(py)
+}
+
+/// Maps the atlas from `index × spacing` into `world`, as the CLI places a file's mesh; a
+/// mirroring map turns every triangle, so each still faces from its first label to its second.
+fn place<L>(world: &World, atlas: &mut Atlas<L>) {
+    let mut mesh = Mesh {
+        positions: std::mem::take(&mut atlas.positions),
+        triangles: std::mem::take(&mut atlas.triangles),
+        ..Mesh::default()
+    };
+    world.place(&mut mesh);
+    atlas.positions = mesh.positions;
+    atlas.triangles = mesh.triangles;
+}
+
+/// The labels to mesh: all of `present` (the labels with a surface), or the selection, each of
+/// which must be one of them.
+fn choose<'py, L: Label + Display + FromPyObjectOwned<'py>>(
+    present: &[L],
+    background: L,
+    selection: Option<Vec<Bound<'py, PyAny>>>,
+) -> PyResult<Vec<L>> {
+    let Some(selection) = selection else {
+        return Ok(present.to_vec());
+    };
+    if selection.is_empty() {
+        return Err(PyValueError::new_err(
+            "labels: the selection is empty; pass None to mesh every label",
+        ));
+    }
+    let mut chosen = Vec::with_capacity(selection.len());
+    let mut missing = Vec::new();
+    for wanted in &selection {
+        match wanted.extract::<L>() {
+            Ok(l) if l == background => {
+                return Err(PyValueError::new_err(format!(
+                    "labels: {wanted} is the background, which is not meshed; \
+                     pass background= another value to mesh it"
+                )));
+            }
+            Ok(l) if present.binary_search(&l).is_ok() => chosen.push(l),
+            _ => missing.push(wanted),
+        }
+    }
+    if !missing.is_empty() {
+        let present_list = match present.len() {
+            0 => "none has a surface".to_string(),
+            n => format!("those with a surface are {} ({n} in all)", list(present)),
+        };
+        return Err(PyValueError::new_err(format!(
+            "labels: {} not in the volume; {present_list}",
+            list(&missing)
+        )));
+    }
+    chosen.sort_unstable();
+    chosen.dedup();
+    Ok(chosen)
+}
+
+/// The first [`LISTED`] of `items`, comma-separated, with an ellipsis for the rest.
+fn list<T: Display>(items: &[T]) -> String {
+    let mut out: Vec<String> = items.iter().take(LISTED).map(T::to_string).collect();
+    if items.len() > LISTED {
+        out.push("…".into());
+    }
+    out.join(", ")
+}
