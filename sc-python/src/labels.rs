@@ -14,7 +14,7 @@ use sc_runtime::labels::{Atlas, Label, LabelParams, extract_labels};
 use sc_runtime::{Mesh, Volume};
 
 use crate::convert::{self, with_type};
-use crate::{errors, extract};
+use crate::{arguments, errors, extract};
 
 /// The label types, in the order error messages list them.
 pub const TYPES: &str = "uint8, uint16, uint32, uint64, int16 or int32";
@@ -27,7 +27,7 @@ const LISTED: usize = 10;
 /// or every label but the background. Returns `(vertices, faces, face_labels, meshes, stats)`:
 /// the atlas, then `(label, vertices, faces, normals or None, stats)` per label meshed, ascending.
 #[pyfunction]
-#[pyo3(signature = (volume, spacing, origin, background, mode, pad, normals, selection=None, affine=None, space=None))]
+#[pyo3(signature = (volume, spacing, origin, background, mode, pad, normals, threads, selection=None, affine=None, space=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn labels<'py>(
     py: Python<'py>,
@@ -38,6 +38,7 @@ pub fn labels<'py>(
     mode: &str,
     pad: bool,
     normals: bool,
+    threads: &Bound<'py, PyAny>,
     selection: Option<Vec<Bound<'py, PyAny>>>,
     affine: Option<[[f64; 4]; 3]>,
     space: Option<&str>,
@@ -52,6 +53,7 @@ pub fn labels<'py>(
         mode,
         pad,
         normals,
+        threads: arguments::threads(threads)?,
         selection,
     };
     with_type!(py, volume, "volume", TYPES, [u8, u16, u32, u64, i16, i32], L => {
@@ -69,6 +71,7 @@ struct Request<'a, 'py> {
     mode: &'a str,
     pad: bool,
     normals: bool,
+    threads: usize,
     selection: Option<Vec<Bound<'py, PyAny>>>,
 }
 
@@ -89,6 +92,7 @@ where
         mode: mode_name,
         pad,
         normals,
+        threads,
         selection,
     } = request;
     let dtype = numpy::dtype::<L>(py);
@@ -103,6 +107,7 @@ where
         pad,
         spacing,
         origin,
+        threads,
         ..LabelParams::default()
     };
     let mut atlas = {

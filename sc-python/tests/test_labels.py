@@ -342,3 +342,18 @@ def test_to_pyvista_gives_a_block_per_label():
     assert list(blocks.keys()) == [str(label) for label in result]
     for label, mesh in result.items():
         assert blocks[str(label)].n_cells == len(mesh.faces)
+
+
+def test_any_thread_count_gives_the_same_atlas():
+    rng = np.random.default_rng(5)
+    seeds = rng.uniform(0, 40, size=(12, 3))
+    grid = np.stack(np.meshgrid(*(np.arange(n) for n in (40, 9, 8)), indexing="ij"), -1)
+    volume = np.argmin(((grid[..., None, :] - seeds) ** 2).sum(-1), -1).astype(np.uint16)
+    one = skelclimb.labels(volume, threads=1)
+    for threads in (2, 3, 0):
+        other = skelclimb.labels(volume, threads=threads)
+        np.testing.assert_array_equal(other.atlas.vertices, one.atlas.vertices)
+        np.testing.assert_array_equal(other.atlas.faces, one.atlas.faces)
+        np.testing.assert_array_equal(other.atlas.face_labels, one.atlas.face_labels)
+    with pytest.raises(ValueError):
+        skelclimb.labels(volume, threads=-1)

@@ -89,6 +89,7 @@ def labels(
     mode: _Mode = ...,
     pad: bool = ...,
     normals: bool = ...,
+    threads: int = ...,
 ) -> Labels: ...
 
 class Scan(NamedTuple):

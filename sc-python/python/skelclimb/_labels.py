@@ -151,6 +151,7 @@ def labels(
     mode="embedded",
     pad=True,
     normals=True,
+    threads=0,
 ):
     """Meshes every region of a label volume in one sweep: a closed mesh per label, whose
     neighbours share their interfaces exactly.
@@ -181,12 +182,14 @@ def labels(
         is closed where it touches the volume's border.
     normals : bool
         Per-vertex normals of each label's mesh, pointing out of the label (area-weighted).
+    threads : int
+        Threads to mesh on, 0 (the default) for every core; the result does not depend on it.
 
     Returns
     -------
     Labels
         ``result[label]`` is that label's :class:`Mesh`; ``result.atlas`` holds every interface
-        once. The GIL is released while the meshes are built (one thread).
+        once. The GIL is released while the meshes are built.
 
     Examples
     --------
@@ -208,7 +211,7 @@ def labels(
     affine, spacing, origin = _placement(affine, spacing, origin)
     _mode(mode)
     verts, faces, face_labels, meshes, stats = _native.labels(
-        volume, spacing, origin, background, mode, bool(pad), bool(normals), selection,
+        volume, spacing, origin, background, mode, bool(pad), bool(normals), threads, selection,
         None if affine is None else affine[:3].tolist(), space,
     )
     if face_labels.dtype != dtype:
