@@ -88,11 +88,10 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         coordinates: args.space,
         selection: args.labels.clone().unwrap_or(labels::Selection::All),
     };
-    let result = labels::extract(&grid, &request, &progress)
-        .map_err(|e| match e {
-            Error::Usage(message) => Error::file(input, message),
-            e => e,
-        })?;
+    let result = labels::extract(&grid, &request, &progress).map_err(|e| match e {
+        Error::Usage(message) => Error::file(input, message),
+        e => e,
+    })?;
     let extract_time = clock.elapsed();
 
     let clock = Instant::now();
@@ -127,7 +126,8 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             let written = clock.elapsed();
             let report_file = match stats_file {
                 Some(file) => Some(file.fill(|out| {
-                    serde_json::to_writer_pretty(out, &report(written)).map_err(std::io::Error::other)
+                    serde_json::to_writer_pretty(out, &report(written))
+                        .map_err(std::io::Error::other)
                 })?),
                 None => None,
             };
@@ -153,7 +153,11 @@ fn summary(
     result: &LabelMeshes,
     [read, extract]: [std::time::Duration; 2],
 ) -> serde_json::Value {
-    let per_label: u64 = result.meshes.iter().map(|(_, m)| m.triangles.len() as u64).sum();
+    let per_label: u64 = result
+        .meshes
+        .iter()
+        .map(|(_, m)| m.triangles.len() as u64)
+        .sum();
     json!({
         "input": input.display().to_string(),
         "format": grid.format,
@@ -182,7 +186,12 @@ fn print(summary: &serde_json::Value, output: &Path) {
         summary["format"].as_str().unwrap_or_default(),
         dims.join("×"),
         summary["dtype"].as_str().unwrap_or_default(),
-        mode_name(summary["atlas"]["mode"].as_str().and_then(|m| m.parse().ok()).unwrap_or_default()),
+        mode_name(
+            summary["atlas"]["mode"]
+                .as_str()
+                .and_then(|m| m.parse().ok())
+                .unwrap_or_default()
+        ),
     );
     println!(
         "  atlas, each interface once: {} triangles, {} vertices; per-label meshes: {} triangles",
