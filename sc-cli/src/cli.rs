@@ -83,7 +83,8 @@ pub struct MergeArgs {
 /// Arguments of `render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The mesh: .ply (text or binary), .obj or .stl.
+    /// The mesh: .ply (text or binary), .obj or .stl; or a directory of label meshes
+    /// (`extract --labels -o DIR`), each label in a colour of its own.
     pub mesh: PathBuf,
     /// The picture to write (.png).
     #[arg(short, long)]

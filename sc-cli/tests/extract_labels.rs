@@ -85,6 +85,25 @@ fn a_file_per_label_each_closed_and_named_from_the_table_beside() {
         );
         total += closed(&out.join(name));
     }
+    // The directory renders, each label in a colour of its own.
+    let png = dir.path().join("atlas.png");
+    let render = Command::cargo_bin("skelclimb")
+        .unwrap()
+        .args([
+            "render",
+            out.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        render.status.success(),
+        "{}",
+        String::from_utf8_lossy(&render.stderr)
+    );
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!(report["per_label_triangles"], total as u64);

@@ -20,12 +20,20 @@ pub struct TriangleMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// Whether [`read`] reads `path`, by its extension.
+pub fn readable(path: &Path) -> bool {
+    matches!(extension(path).as_str(), "ply" | "obj" | "stl")
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
 /// Reads `path` by its extension: `.ply` (text or binary), `.obj` or `.stl` (text or binary).
 pub fn read(path: &Path) -> Result<TriangleMesh> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
+    let ext = extension(path);
     let open = || crate::input::open(path);
     let mesh = match ext.as_str() {
         "ply" => ply(path, open()?)?,

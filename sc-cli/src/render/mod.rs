@@ -107,7 +107,13 @@ pub fn run(args: &RenderArgs, quiet: bool) -> Result<()> {
         Some(View::Iso) | None => (args.azimuth.unwrap_or(35.0), args.elevation.unwrap_or(25.0)),
     };
     let camera = Camera::new(azimuth, elevation);
-    let mut meshes = vec![read(&args.mesh)?];
+    let (first, labels) = if args.mesh.is_dir() {
+        let (mesh, colours) = read_labels(&args.mesh)?;
+        (mesh, Some(colours))
+    } else {
+        (read(&args.mesh)?, None)
+    };
+    let mut meshes = vec![first];
     if let Some(other) = &args.compare {
         meshes.push(read(other)?);
     }
@@ -156,7 +162,11 @@ pub fn run(args: &RenderArgs, quiet: bool) -> Result<()> {
         label_room,
     };
     for (n, m) in meshes.iter().enumerate() {
-        let tint = colours.as_ref().filter(|_| n == 0);
+        let tint = match (n, &colours, &labels) {
+            (0, Some((d, max)), _) => Tint::Error(d, *max),
+            (0, None, Some(labels)) => Tint::Labels(labels),
+            _ => Tint::Plain,
+        };
         draw(&mut image, m, &camera, &frame, n * width, args, tint);
         if panels > 1 {
             let label = format!(
@@ -192,6 +202,54 @@ fn read(path: &Path) -> Result<TriangleMesh> {
     mesh_in::read(path)
 }
 
+/// The meshes of a directory of label meshes as one, with each triangle's colour: the label's
+/// default colour, the id read from the file's name (`17-Name.ply`, `label-17.ply`).
+fn read_labels(dir: &Path) -> Result<(TriangleMesh, Vec<[f64; 3]>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map_err(|e| Error::io(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| mesh_in::readable(p))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(Error::file(
+            dir,
+            "no .ply, .obj or .stl mesh in the directory",
+        ));
+    }
+    let mut all = TriangleMesh::default();
+    let mut colours = Vec::new();
+    for path in files {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy())
+            .unwrap_or_default();
+        let id = stem
+            .trim_start_matches("label-")
+            .split('-')
+            .next()
+            .and_then(|n| n.parse::<u64>().ok())
+            .unwrap_or(0);
+        let mesh = read(&path)?;
+        let base = all.positions.len() as u32;
+        all.positions.extend_from_slice(&mesh.positions);
+        all.triangles
+            .extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
+        let rgb = sc_io::labels::default_rgb(id).map(f64::from);
+        colours.resize(all.triangles.len(), rgb);
+    }
+    Ok((all, colours))
+}
+
+/// How a panel's triangles are coloured.
+enum Tint<'a> {
+    Plain,
+    /// By distance to a reference, up to the largest.
+    Error(&'a [f64], f64),
+    /// Per triangle.
+    Labels(&'a [[f64; 3]]),
+}
+
 /// Where world units land on the picture.
 struct Frame {
     centre: [f64; 2],
@@ -219,7 +277,7 @@ fn draw(
     frame: &Frame,
     left: usize,
     args: &RenderArgs,
-    errors: Option<&(Vec<f64>, f64)>,
+    tint: Tint,
 ) {
     let (w, h) = (frame.width, frame.height);
     let mut depth = vec![f64::NEG_INFINITY; w * h];
@@ -255,9 +313,10 @@ fn draw(
     });
     for (n, t) in mesh.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|i| screen[i as usize]);
-        let base = match errors {
-            Some((d, max)) => ramp(if *max > 0.0 { d[n] / max } else { 0.0 }),
-            None => SURFACE,
+        let base = match tint {
+            Tint::Error(d, max) => ramp(if max > 0.0 { d[n] / max } else { 0.0 }),
+            Tint::Labels(colours) => colours[n],
+            Tint::Plain => SURFACE,
         };
         let flat = shade(face_normal(t));
         let lights = t.map(|i| vertex_light.as_ref().map_or(flat, |l| l[i as usize]));
