@@ -20,18 +20,17 @@ use crate::Mode;
 pub(super) fn merge<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
-    mut ears: Vec<Ear<L>>,
+    ears: Vec<Ear<L>>,
     atlas: &mut Atlas<L>,
 ) {
     if ears.is_empty() {
         return;
     }
-    ears.sort_unstable_by_key(|e| e.vertex);
     let mut gone_vertex = vec![false; atlas.positions.len()];
     let mut gone_triangle = vec![false; atlas.triangles.len()];
-    for group in ears.chunk_by(|a, b| a.vertex == b.vertex) {
-        // Fewer than four ears: a cube around the edge is not binary, or lies outside the grid.
-        let [a, b, c, d] = group else { continue };
+    for group in around(&ears, atlas.positions.len()) {
+        let [a, b, c, d] = group.map(|e| &ears[e as usize]);
+        let group = [a, b, c, d];
         let w = a.background;
         let allowed = [b, c, d].iter().all(|e| e.background == w)
             && (params.mode == Mode::Paper
@@ -49,6 +48,36 @@ pub(super) fn merge<L: Label>(
         atlas.stats.merged += 1;
     }
     compact(atlas, &gone_vertex, &gone_triangle);
+}
+
+/// The ears of each grey vertex with four, by ascending vertex, each group in the order the ears
+/// came: a counting sort, the ears being many and their vertices dense.
+fn around<L>(ears: &[Ear<L>], vertices: usize) -> Vec<[u32; 4]> {
+    let mut count = vec![0u8; vertices];
+    for ear in ears {
+        let c = &mut count[ear.vertex as usize];
+        *c = c.saturating_add(1);
+    }
+    // Fewer than four ears: a cube around the edge is not binary, or lies outside the grid.
+    let mut slot = vec![u32::MAX; vertices];
+    let mut groups = 0u32;
+    for (s, &c) in slot.iter_mut().zip(&count) {
+        if c == 4 {
+            *s = groups;
+            groups += 1;
+        }
+    }
+    let mut out = vec![[0u32; 4]; groups as usize];
+    let mut filled = vec![0u8; groups as usize];
+    for (n, ear) in ears.iter().enumerate() {
+        let g = slot[ear.vertex as usize];
+        if g != u32::MAX {
+            let f = &mut filled[g as usize];
+            out[g as usize][usize::from(*f)] = n as u32;
+            *f += 1;
+        }
+    }
+    out
 }
 
 /// The two triangles replacing the four ears `[back, grey, forward]` around a grey vertex, split

@@ -171,7 +171,16 @@ fn sweep_pieces<L: Label>(
 impl<L: Label> Atlas<L> {
     /// The labels with a surface, ascending, without the background (`background`).
     pub fn labels(&self, background: L) -> Vec<L> {
-        let mut labels: Vec<L> = self.pairs.iter().flatten().copied().collect();
+        // Neighbouring triangles mostly share their pair: skipping repeats first leaves little
+        // to sort.
+        let mut labels: Vec<L> = Vec::new();
+        let mut last = None;
+        for &pair in &self.pairs {
+            if last != Some(pair) {
+                labels.extend(pair);
+                last = Some(pair);
+            }
+        }
         labels.sort_unstable();
         labels.dedup();
         labels.retain(|&l| l != background);

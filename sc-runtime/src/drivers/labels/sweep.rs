@@ -111,79 +111,98 @@ const fn edge_axis(e: u8) -> usize {
 }
 
 /// Vertex ids of the nodes shared between cubes, for the planes and layer in reach: x- and
-/// y-edges and z-facing face centres of planes `k` and `k + 1` (slot `z % 2`), z-edges and
-/// x- and y-facing face centres of layer `k`. A slot holds its id plus one, and counts only if
-/// that id was made since its plane or layer came into reach: ids grow as the sweep goes, so
-/// moving on is two numbers, not a fill of six planes per layer.
+/// y-edges and z-facing face centres of planes `k` and `k + 1` (by `z % 2`), z-edges and x- and
+/// y-facing face centres of layer `k`. A slot holds its id plus one, and counts only if that id
+/// was made since its plane or layer came into reach: ids grow as the sweep goes, so moving on
+/// is a few numbers, not a fill of six planes per layer.
 struct Ids {
     nx: usize,
-    x: [Vec<u32>; 2],
-    y: [Vec<u32>; 2],
-    fz: [Vec<u32>; 2],
-    z: Vec<u32>,
-    fx: Vec<u32>,
-    fy: Vec<u32>,
-    /// Per plane slot, and for the layer: the first id made since it came into reach.
-    since: [u32; 2],
-    since_layer: u32,
+    /// Nine planes of `nx · ny` slots, in the order of [`Ids::X`] and the rest.
+    slots: Vec<u32>,
+    /// Per plane, the first id made since it came into reach.
+    since: [u32; 9],
+    /// Per cube edge, in the current layer: its plane and its offset from the cube's slot.
+    edges: [(usize, usize); 12],
 }
 
 impl Ids {
+    const X: usize = 0;
+    const Y: usize = 2;
+    const Z: usize = 4;
+    const FX: usize = 5;
+    const FY: usize = 6;
+    const FZ: usize = 7;
+
     fn new(nx: usize, ny: usize) -> Ids {
-        let plane = || vec![0; nx * ny];
         Ids {
             nx,
-            x: [plane(), plane()],
-            y: [plane(), plane()],
-            fz: [plane(), plane()],
-            z: plane(),
-            fx: plane(),
-            fy: plane(),
-            since: [0; 2],
-            since_layer: 0,
+            slots: vec![0; 9 * nx * ny],
+            since: [0; 9],
+            edges: [(0, 0); 12],
         }
     }
 
-    /// Brings plane `k + 1` (in plane `k − 1`'s slot) and layer `k` into reach; `next` is the
-    /// next id to be made.
-    fn next_layer(&mut self, k: usize, next: u32) {
-        self.since[(k + 1) % 2] = next;
-        self.since_layer = next;
+    fn plane_len(&self) -> usize {
+        self.slots.len() / 9
     }
 
-    /// Plane `z`'s slots, with those not made since it came into reach cleared.
+    /// Brings layer `k` and plane `k + 1` into reach (the latter in plane `k − 1`'s slots, if
+    /// `k` is not the first layer); `next` is the next id to be made.
+    fn start_layer(&mut self, k: usize, next: u32, first: bool) {
+        let s = (k + 1) % 2;
+        if !first {
+            for plane in [Self::X + s, Self::Y + s, Self::FZ + s] {
+                self.since[plane] = next;
+            }
+            for plane in [Self::Z, Self::FX, Self::FY] {
+                self.since[plane] = next;
+            }
+        }
+        let n = self.plane_len();
+        for (e, slot) in self.edges.iter_mut().enumerate() {
+            let [dx, dy, dz] = EDGE_LOWER[e];
+            let plane = match edge_axis(e as u8) {
+                0 => Self::X + (k + dz) % 2,
+                1 => Self::Y + (k + dz) % 2,
+                _ => Self::Z,
+            };
+            *slot = (plane, plane * n + dx + self.nx * dy);
+        }
+    }
+
+    /// Plane `z`'s slots (x-edges, y-edges, face centres), with those not made since it came
+    /// into reach cleared.
     fn plane(&self, z: usize) -> [Vec<u32>; 3] {
+        let n = self.plane_len();
         let s = z % 2;
-        let since = self.since[s];
-        [&self.x[s], &self.y[s], &self.fz[s]]
-            .map(|ids| ids.iter().map(|&v| if v > since { v } else { 0 }).collect())
+        [Self::X + s, Self::Y + s, Self::FZ + s].map(|plane| {
+            let since = self.since[plane];
+            self.slots[plane * n..][..n]
+                .iter()
+                .map(|&v| if v > since { v } else { 0 })
+                .collect()
+        })
     }
 
-    /// The slot of the vertex on the edge from `lower` along `axis`, and the first id it may
-    /// hold.
+    /// The slot of the vertex on cube edge `e` of the cube at `at` (`i + nx · j`) in this
+    /// layer, and the first id it may hold.
     #[inline]
-    fn edge(&mut self, lower: [usize; 3], axis: usize) -> (&mut u32, u32) {
-        let at = lower[0] + self.nx * lower[1];
-        let s = lower[2] % 2;
-        match axis {
-            0 => (&mut self.x[s][at], self.since[s]),
-            1 => (&mut self.y[s][at], self.since[s]),
-            _ => (&mut self.z[at], self.since_layer),
-        }
+    fn edge(&mut self, at: usize, e: u8) -> (&mut u32, u32) {
+        let (plane, offset) = self.edges[usize::from(e)];
+        (&mut self.slots[offset + at], self.since[plane])
     }
 
-    /// [`Ids::edge`] for the centre of face `f` of `cube`.
+    /// [`Ids::edge`] for the centre of face `f` of the cube `[i, j, k]`.
     fn face(&mut self, cube: [usize; 3], f: u8) -> (&mut u32, u32) {
         let side = usize::from(f % 2);
         let [i, j, k] = cube;
-        match f / 2 {
-            0 => (&mut self.fx[i + side + self.nx * j], self.since_layer),
-            1 => (&mut self.fy[i + self.nx * (j + side)], self.since_layer),
-            _ => {
-                let s = (k + side) % 2;
-                (&mut self.fz[s][i + self.nx * j], self.since[s])
-            }
-        }
+        let (plane, at) = match f / 2 {
+            0 => (Self::FX, i + side + self.nx * j),
+            1 => (Self::FY, i + self.nx * (j + side)),
+            _ => (Self::FZ + (k + side) % 2, i + self.nx * j),
+        };
+        let n = self.plane_len();
+        (&mut self.slots[plane * n + at], self.since[plane])
     }
 }
 
@@ -269,17 +288,15 @@ pub(super) fn sweep<L: Label>(
         vec![grid.background; nx * ny],
         vec![grid.background; nx * ny],
     ];
-    let mut mask = vec![0u8; nx];
+    let mut mask = vec![0u8; nx - 1];
     let mut bottom = [Vec::new(), Vec::new(), Vec::new()];
     let first = layers.start;
     grid.plane(first, &mut planes[first % 2]);
     for k in layers.clone() {
-        if k > first {
-            if k == first + 1 {
-                bottom = ids.plane(first);
-            }
-            ids.next_layer(k, out.atlas.positions.len() as u32);
+        if k == first + 1 {
+            bottom = ids.plane(first);
         }
+        ids.start_layer(k, out.atlas.positions.len() as u32, k == first);
         grid.plane(k + 1, &mut planes[(k + 1) % 2]);
         let (lower, upper) = (&planes[k % 2], &planes[(k + 1) % 2]);
         for j in 0..ny - 1 {
@@ -290,17 +307,7 @@ pub(super) fn sweep<L: Label>(
                 &upper[(j + 1) * nx..][..nx],
             ];
             differs(rows, &mut mask);
-            for i in 0..nx - 1 {
-                // Most cubes hold one label: skipped eight at a time.
-                if i % 8 == 0 && i + 8 < nx {
-                    let chunk: [u8; 8] = mask[i..i + 8].try_into().unwrap_or([1; 8]);
-                    if u64::from_ne_bytes(chunk) == 0 {
-                        continue;
-                    }
-                }
-                if mask[i] == 0 {
-                    continue;
-                }
+            for i in changed(&mask) {
                 let labels = [
                     rows[0][i],
                     rows[0][i + 1],
@@ -312,6 +319,7 @@ pub(super) fn sweep<L: Label>(
                     rows[3][i + 1],
                 ];
                 let cube = [i, j, k];
+                let here = i + nx * j;
                 let keys = labels.map(|l| grid.key(l));
                 let (kind, built) = match few_labels(&keys) {
                     Some(kind) => (kind, &[][..]),
@@ -321,14 +329,14 @@ pub(super) fn sweep<L: Label>(
                     Kind::Uniform => {}
                     Kind::Binary { background, case } => {
                         let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
-                        let at = class * 256 + usize::from(case);
-                        let entry = &table[at];
+                        let case_at = class * 256 + usize::from(case);
+                        let entry = &table[case_at];
                         let w = labels[usize::from(background)];
                         let mut first = 0;
                         for (n, tri) in entry.tris[..usize::from(entry.count)].iter().enumerate() {
                             let mut t = [0; 3];
                             for (v, &e) in t.iter_mut().zip(tri) {
-                                *v = edge_vertex(&mut ids, &mut out, cube, e)?;
+                                *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
                             }
                             let (a, b) = edge_corners(tri[0]);
                             let x = if labels[usize::from(a)] == w {
@@ -350,12 +358,12 @@ pub(super) fn sweep<L: Label>(
                                 continue;
                             }
                             let [back, grey, forward] = entry.tris[usize::from(ear)];
-                            let vertex = *ids.edge(edge_lower(cube, grey), axis).0 - 1;
+                            let vertex = *ids.edge(here, grey).0 - 1;
                             ears.push(Ear {
                                 vertex,
                                 triangle: first + u32::from(ear),
                                 background: w,
-                                mergeable: mergeable[at] >> axis & 1 == 1,
+                                mergeable: mergeable[case_at] >> axis & 1 == 1,
                                 diagonal: u8::from(in_diagonal_plane(cube, grey, back))
                                     | u8::from(in_diagonal_plane(cube, grey, forward)) << 1,
                                 lower: edge_lower(cube, grey),
@@ -369,7 +377,9 @@ pub(super) fn sweep<L: Label>(
                             let mut t = [0; 3];
                             for (v, &local) in t.iter_mut().zip(&triangle) {
                                 *v = match local {
-                                    Local::Edge(e) => edge_vertex(&mut ids, &mut out, cube, e)?,
+                                    Local::Edge(e) => {
+                                        edge_vertex(&mut ids, &mut out, cube, here, e)?
+                                    }
                                     Local::Face(f) => shared(ids.face(cube, f), || {
                                         out.vertex(cube, local.quarters())
                                     })?,
@@ -457,10 +467,26 @@ impl Patterns {
     }
 }
 
+/// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
+fn changed(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
+    mask.chunks(8).enumerate().flat_map(|(n, chunk)| {
+        let mut bytes = [0u8; 8];
+        bytes[..chunk.len()].copy_from_slice(chunk);
+        let mut word = u64::from_le_bytes(bytes);
+        core::iter::from_fn(move || {
+            let k = word.trailing_zeros() / 8;
+            (word != 0).then(|| {
+                word &= !(0xFF << (8 * k));
+                8 * n + k as usize
+            })
+        })
+    })
+}
+
 /// Per cube of a row, 1 if its eight corners (`rows`: y and y + 1 at z, then at z + 1) do not
 /// all hold one label. Written without branches, so that it vectorises.
 fn differs<L: Label>(rows: [&[L]; 4], mask: &mut [u8]) {
-    let n = mask.len() - 1;
+    let n = mask.len();
     let [a, b, c, d] = rows.map(|r| &r[..n + 1]);
     for i in 0..n {
         let v = a[i];
@@ -494,13 +520,15 @@ const EDGE_LOWER: [[usize; 3]; 12] = {
 };
 
 /// The vertex on cube edge `e`, made at its midpoint when first used.
+#[inline]
 fn edge_vertex<L>(
     ids: &mut Ids,
     out: &mut Out<'_, L>,
     cube: [usize; 3],
+    at: usize,
     e: u8,
 ) -> Result<u32, Error> {
-    shared(ids.edge(edge_lower(cube, e), edge_axis(e)), || {
+    shared(ids.edge(at, e), || {
         out.vertex(cube, Local::Edge(e).quarters())
     })
 }
