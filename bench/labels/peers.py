@@ -277,6 +277,9 @@ def peer_skelclimb(vol, meta, labels, spacing):
     params = inspect.signature(fn).parameters
     if "threads" in params:
         kwargs["threads"] = 1
+    # Like the peers, which return no normals.
+    if "normals" in params:
+        kwargs["normals"] = False
 
     def run():
         t0 = time.perf_counter()
