@@ -61,6 +61,9 @@ pub enum Error {
         /// The broken rule, in words.
         what: &'static str,
     },
+    /// A label extraction's smoothing width is negative, not finite, or wider than
+    /// [`MAX_SMOOTHING`](crate::labels::MAX_SMOOTHING) voxels.
+    Smoothing,
     /// The joined blocks do not cover the grid.
     BlocksMissing {
         /// Cubes the blocks own.
@@ -114,6 +117,11 @@ impl fmt::Display for Error {
                 write!(f, "two block meshes both own cube {cube}")
             }
             Error::BlockMalformed { what } => write!(f, "the block mesh is malformed: {what}"),
+            Error::Smoothing => write!(
+                f,
+                "the smoothing width is in voxels, from 0 (none) to {}",
+                crate::kernel::labels::MAX_SMOOTHING
+            ),
             Error::BlocksMissing { covered, cubes } => write!(
                 f,
                 "the joined blocks cover {covered} of the grid's {cubes} cubes"

@@ -4,12 +4,15 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::sweep::{Ear, Piece};
+use super::sweep::{Ear, Edge, Piece};
 use super::{Atlas, Label};
 use crate::Stats;
 
-/// The pieces, in order of their layers, as one atlas, with their ears renumbered alike.
-pub(super) fn join<L: Label>(pieces: Vec<Piece<L>>) -> (Atlas<L>, Vec<Ear<L>>) {
+/// The pieces, in order of their layers, as one atlas, with their ears, vertex edges and
+/// pinned vertices renumbered alike.
+pub(super) fn join<L: Label>(
+    pieces: Vec<Piece<L>>,
+) -> (Atlas<L>, Vec<Ear<L>>, Vec<Edge>, Vec<u32>) {
     let mut atlas = Atlas {
         positions: Vec::new(),
         triangles: Vec::new(),
@@ -17,6 +20,8 @@ pub(super) fn join<L: Label>(pieces: Vec<Piece<L>>) -> (Atlas<L>, Vec<Ear<L>>) {
         stats: Stats::default(),
     };
     let mut ears = Vec::new();
+    let mut edges = Vec::new();
+    let mut pinned = Vec::new();
     // The previous piece's top plane, in the joined numbering (plus one, 0 for none).
     let mut shared: Option<[Vec<u32>; 3]> = None;
     for piece in pieces {
@@ -34,12 +39,16 @@ pub(super) fn join<L: Label>(pieces: Vec<Piece<L>>) -> (Atlas<L>, Vec<Ear<L>>) {
                 }
             }
         }
-        for (n, p) in number.iter_mut().zip(&piece.atlas.positions) {
+        for (v, (n, p)) in number.iter_mut().zip(&piece.atlas.positions).enumerate() {
             if *n == u32::MAX {
                 *n = atlas.positions.len() as u32;
                 atlas.positions.push(*p);
+                if let Some(&edge) = piece.edges.get(v) {
+                    edges.push(edge);
+                }
             }
         }
+        pinned.extend(piece.pinned.iter().map(|&v| number[v as usize]));
         let first_triangle = atlas.triangles.len() as u32;
         atlas.triangles.extend(
             piece
@@ -67,5 +76,5 @@ pub(super) fn join<L: Label>(pieces: Vec<Piece<L>>) -> (Atlas<L>, Vec<Ear<L>>) {
                 .collect()
         }));
     }
-    (atlas, ears)
+    (atlas, ears, edges, pinned)
 }

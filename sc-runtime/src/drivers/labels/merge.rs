@@ -16,15 +16,16 @@ use super::sweep::{Ear, Padded};
 use super::{Atlas, Label, LabelParams};
 use crate::Mode;
 
-/// Merges what may merge among `ears`, then drops the vertices and triangles merged away.
+/// Merges what may merge among `ears`, then drops the vertices and triangles merged away;
+/// returns each old vertex's new id (`u32::MAX` if dropped), if any ear was looked at.
 pub(super) fn merge<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
     ears: Vec<Ear<L>>,
     atlas: &mut Atlas<L>,
-) {
+) -> Option<Vec<u32>> {
     if ears.is_empty() {
-        return;
+        return None;
     }
     let mut gone_vertex = vec![false; atlas.positions.len()];
     let mut gone_triangle = vec![false; atlas.triangles.len()];
@@ -47,7 +48,7 @@ pub(super) fn merge<L: Label>(
         gone_vertex[a.vertex as usize] = true;
         atlas.stats.merged += 1;
     }
-    compact(atlas, &gone_vertex, &gone_triangle);
+    Some(compact(atlas, &gone_vertex, &gone_triangle))
 }
 
 /// The ears of each grey vertex with four, by ascending vertex, each group in the order the ears
@@ -150,8 +151,13 @@ fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> b
     }
 }
 
-/// Drops the marked vertices and triangles, renumbering the vertices in their order.
-fn compact<L: Copy>(atlas: &mut Atlas<L>, gone_vertex: &[bool], gone_triangle: &[bool]) {
+/// Drops the marked vertices and triangles, renumbering the vertices in their order; returns
+/// the new ids.
+fn compact<L: Copy>(
+    atlas: &mut Atlas<L>,
+    gone_vertex: &[bool],
+    gone_triangle: &[bool],
+) -> Vec<u32> {
     let mut new_id = vec![u32::MAX; gone_vertex.len()];
     let mut next = 0u32;
     let mut kept = 0;
@@ -175,4 +181,5 @@ fn compact<L: Copy>(atlas: &mut Atlas<L>, gone_vertex: &[bool], gone_triangle: &
     }
     atlas.triangles.truncate(t_kept);
     atlas.pairs.truncate(t_kept);
+    new_id
 }

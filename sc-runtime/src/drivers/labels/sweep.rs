@@ -224,7 +224,18 @@ struct Out<'p, L> {
     spacing: [f64; 3],
     /// The world position of padded sample `(0, 0, 0)`.
     origin: [f64; 3],
+    /// With smoothing, per vertex: the grid edge it lies on (lower end, axis), or
+    /// [`NOT_ON_AN_EDGE`].
+    edges: Option<Vec<Edge>>,
+    /// With smoothing, the vertices of hub cubes, which stay where they are made.
+    pinned: Vec<u32>,
 }
+
+/// A grid edge: its lower end in the padded grid, and its axis.
+pub(super) type Edge = [u32; 4];
+
+/// [`Edge`] for a vertex that is not an edge's (a face's or cube's centre, a hub's).
+pub(super) const NOT_ON_AN_EDGE: Edge = [u32::MAX; 4];
 
 impl<L> Out<'_, L> {
     /// A new vertex at `quarters` (quarters of a cube side) from `cube`'s lower corner.
@@ -239,6 +250,20 @@ impl<L> Out<'_, L> {
                 as f32
         });
         self.atlas.positions.push(p);
+        if let Some(edges) = &mut self.edges {
+            edges.push(NOT_ON_AN_EDGE);
+        }
+        Ok(id)
+    }
+
+    /// A new vertex at the midpoint of cube edge `e` of `cube`.
+    fn edge_vertex(&mut self, cube: [usize; 3], e: u8) -> Result<u32, Error> {
+        let id = self.vertex(cube, Local::Edge(e).quarters())?;
+        if let Some(edges) = &mut self.edges {
+            let [x, y, z] = edge_lower(cube, e);
+            // The padded grid's sizes fit in u32 (its vertex ids do).
+            edges[id as usize] = [x as u32, y as u32, z as u32, edge_axis(e) as u32];
+        }
         Ok(id)
     }
 
@@ -257,6 +282,9 @@ pub(super) struct Piece<L> {
     /// face centres, and of the plane after the last layer: the vertices two pieces share.
     pub bottom: [Vec<u32>; 3],
     pub top: [Vec<u32>; 3],
+    /// With smoothing: per vertex its grid edge, and the vertices that stay (see `Out`).
+    pub edges: Vec<Edge>,
+    pub pinned: Vec<u32>,
 }
 
 /// Steps 1–3 over `layers` of the padded grid. Vertices are numbered as the piece first uses
@@ -280,6 +308,8 @@ pub(super) fn sweep<L: Label>(
         atlas: &mut atlas,
         spacing: params.spacing,
         origin: core::array::from_fn(|a| params.origin[a] - pad * params.spacing[a]),
+        edges: (params.smoothing > 0.0).then(Vec::new),
+        pinned: Vec::new(),
     };
     let table = params.tables.for_mode(params.mode);
     let mergeable = params.tables.mergeable();
@@ -398,6 +428,15 @@ pub(super) fn sweep<L: Label>(
                                 };
                             }
                             out.triangle(t, [labels[usize::from(a)], labels[usize::from(b)]]);
+                            // A hub's walls and floors are radial from the cube's centre only
+                            // with their nodes at midpoints: smoothing leaves them there.
+                            if out.edges.is_some()
+                                && triangle.iter().any(|l| {
+                                    matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))
+                                })
+                            {
+                                out.pinned.extend(t);
+                            }
                         }
                     }
                 }
@@ -408,7 +447,10 @@ pub(super) fn sweep<L: Label>(
         bottom = ids.plane(first);
     }
     let top = ids.plane(layers.end);
+    let Out { edges, pinned, .. } = out;
     Ok(Piece {
+        edges: edges.unwrap_or_default(),
+        pinned,
         atlas,
         ears,
         bottom,
@@ -528,9 +570,7 @@ fn edge_vertex<L>(
     at: usize,
     e: u8,
 ) -> Result<u32, Error> {
-    shared(ids.edge(at, e), || {
-        out.vertex(cube, Local::Edge(e).quarters())
-    })
+    shared(ids.edge(at, e), || out.edge_vertex(cube, e))
 }
 
 /// Whether the vertex on cube edge `e` is a corner of the merged pair's diagonal for grey edge

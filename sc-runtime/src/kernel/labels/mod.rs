@@ -9,5 +9,9 @@
 mod cube;
 mod face;
 
+/// The widest smoothing a label extraction takes, in voxels: wider, a vertex's place would
+/// average labels several regions away.
+pub const MAX_SMOOTHING: f64 = 4.0;
+
 pub use cube::{Junction, Kind, Local, MAX_TRIANGLES, classify, few_labels, junction};
 pub use face::{FACES, corner_edge, edge_corners};
