@@ -201,6 +201,14 @@ fn refusals_name_the_argument_and_write_nothing() {
         ),
         (vec![crop, "--labels", "all", "-o", "x.ply"], ".glb"),
         (
+            vec![crop, "--labels", "all", "--smoothing", "5", "-o", out],
+            "--smoothing",
+        ),
+        (
+            vec![crop, "--labels", "all", "--smoothing", "nan", "-o", out],
+            "--smoothing",
+        ),
+        (
             vec![float.to_str().unwrap(), "--labels", "all", "-o", out],
             "f32",
         ),
@@ -214,4 +222,32 @@ fn refusals_name_the_argument_and_write_nothing() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
         assert_eq!(entries(dir.path()), before, "{args:?} left a file");
     }
+}
+
+#[test]
+fn smoothing_moves_vertices_and_keeps_every_mesh_closed() {
+    let dir = tempfile::tempdir().unwrap();
+    let crop = crop();
+    let run_to = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            crop.to_str().unwrap(),
+            "--labels",
+            "71",
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        ok(&args);
+        let file = out.join(&entries(&out)[0]);
+        closed(&file);
+        sc_io::mesh_in::read(&file).unwrap()
+    };
+    let (plain, smooth) = (
+        run_to("plain", &[]),
+        run_to("smooth", &["--smoothing", "0.75"]),
+    );
+    assert_eq!(plain.triangles, smooth.triangles);
+    assert_ne!(plain.positions, smooth.positions);
 }

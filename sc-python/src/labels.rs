@@ -27,7 +27,7 @@ const LISTED: usize = 10;
 /// or every label but the background. Returns `(vertices, faces, face_labels, meshes, stats)`:
 /// the atlas, then `(label, vertices, faces, normals or None, stats)` per label meshed, ascending.
 #[pyfunction]
-#[pyo3(signature = (volume, spacing, origin, background, mode, pad, normals, threads, selection=None, affine=None, space=None))]
+#[pyo3(signature = (volume, spacing, origin, background, mode, pad, normals, threads, smoothing, selection=None, affine=None, space=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn labels<'py>(
     py: Python<'py>,
@@ -39,6 +39,7 @@ pub fn labels<'py>(
     pad: bool,
     normals: bool,
     threads: &Bound<'py, PyAny>,
+    smoothing: f64,
     selection: Option<Vec<Bound<'py, PyAny>>>,
     affine: Option<[[f64; 4]; 3]>,
     space: Option<&str>,
@@ -54,6 +55,7 @@ pub fn labels<'py>(
         pad,
         normals,
         threads: arguments::threads(threads)?,
+        smoothing,
         selection,
     };
     with_type!(py, volume, "volume", TYPES, [u8, u16, u32, u64, i16, i32], L => {
@@ -72,6 +74,7 @@ struct Request<'a, 'py> {
     pad: bool,
     normals: bool,
     threads: usize,
+    smoothing: f64,
     selection: Option<Vec<Bound<'py, PyAny>>>,
 }
 
@@ -93,6 +96,7 @@ where
         pad,
         normals,
         threads,
+        smoothing,
         selection,
     } = request;
     let dtype = numpy::dtype::<L>(py);
@@ -108,6 +112,7 @@ where
         spacing,
         origin,
         threads,
+        smoothing,
         ..LabelParams::default()
     };
     let mut atlas = {

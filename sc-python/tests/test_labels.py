@@ -357,3 +357,25 @@ def test_any_thread_count_gives_the_same_atlas():
         np.testing.assert_array_equal(other.atlas.face_labels, one.atlas.face_labels)
     with pytest.raises(ValueError):
         skelclimb.labels(volume, threads=-1)
+
+
+def test_smoothing_moves_vertices_along_their_edges_only():
+    z, y, x = np.mgrid[:24, :24, :24]
+    ball = (((x - 11.5) ** 2 + (y - 11.5) ** 2 + (z - 11.5) ** 2) <= 81).astype(np.uint8)
+    plain = skelclimb.labels(ball)
+    smooth = skelclimb.labels(ball, smoothing=0.75)
+    np.testing.assert_array_equal(plain.atlas.faces, smooth.atlas.faces)
+    moved = plain.atlas.vertices != smooth.atlas.vertices
+    assert moved.any() and (moved.sum(axis=1) <= 1).all()  # along one axis: its edge's
+    assert (np.abs(plain.atlas.vertices - smooth.atlas.vertices) < 0.5).all()
+    def area(m):
+        v, f = m.vertices, m.faces
+        return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum()
+    exact = 4 * np.pi * 81
+    assert area(plain[1]) / exact - 1 > 0.05
+    assert abs(area(smooth[1]) / exact - 1) < 0.01
+    for bad in (-1, 5, float("nan")):
+        with pytest.raises(ValueError, match="smoothing"):
+            skelclimb.labels(ball, smoothing=bad)
+    with pytest.raises(TypeError, match="smoothing"):
+        skelclimb.labels(ball, smoothing="0.5")

@@ -87,6 +87,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         threads: args.threads,
         coordinates: args.space,
         selection: args.labels.clone().unwrap_or(labels::Selection::All),
+        smoothing: args.smoothing,
     };
     let result = labels::extract(&grid, &request, &progress).map_err(|e| match e {
         Error::Usage(message) => Error::file(input, message),
@@ -164,6 +165,7 @@ fn summary(
         "dims": grid.dims,
         "dtype": grid.samples.dtype().name(),
         "background": args.background,
+        "smoothing": args.smoothing,
         "labels": result.meshes.iter().map(|(id, _)| *id).collect::<Vec<_>>(),
         "atlas": report::counts(args.mode, None, &result.stats),
         "per_label_triangles": per_label,

@@ -70,6 +70,8 @@ pub struct LabelRequest {
     pub coordinates: Coordinates,
     /// Which labels get a mesh.
     pub selection: Selection,
+    /// Gaussian width (voxels) of the smoothing along edges; 0 for midpoints.
+    pub smoothing: f64,
 }
 
 /// One closed mesh per label selected, ascending by label.
@@ -143,6 +145,7 @@ where
             [0.0; 3]
         },
         threads: request.threads,
+        smoothing: request.smoothing,
         ..LabelParams::default()
     };
     let volume = Volume::new(data, grid.dims)?;

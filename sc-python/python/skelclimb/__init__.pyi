@@ -90,6 +90,7 @@ def labels(
     pad: bool = ...,
     normals: bool = ...,
     threads: int = ...,
+    smoothing: float = ...,
 ) -> Labels: ...
 
 class Scan(NamedTuple):

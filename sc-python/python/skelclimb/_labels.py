@@ -139,6 +139,16 @@ def _selection(labels):
     return sorted({_index(v, "labels") for v in items})
 
 
+def _smoothing(width):
+    """``width`` as a float in 0..=4, or a ``TypeError``/``ValueError`` naming ``smoothing``."""
+    if isinstance(width, bool) or not isinstance(width, (int, float, np.integer, np.floating)):
+        raise TypeError(f"smoothing: {width!r} is not a number")
+    width = float(width)
+    if not 0.0 <= width <= 4.0:
+        raise ValueError(f"smoothing: {width} is not a width in voxels from 0 to 4")
+    return width
+
+
 def labels(
     volume,
     *,
@@ -152,6 +162,7 @@ def labels(
     pad=True,
     normals=True,
     threads=0,
+    smoothing=0,
 ):
     """Meshes every region of a label volume in one sweep: a closed mesh per label, whose
     neighbours share their interfaces exactly.
@@ -184,6 +195,11 @@ def labels(
         Per-vertex normals of each label's mesh, pointing out of the label (area-weighted).
     threads : int
         Threads to mesh on, 0 (the default) for every core; the result does not depend on it.
+    smoothing : float
+        0 (the default) puts every vertex at the midpoint of its grid edge. A width in voxels
+        (up to 4; 0.75 gives spheres their area within 1 %) slides each vertex along its own
+        edge to where the Gaussian-smoothed regions on either side balance: every sample stays
+        on its own side, and the triangles are the same.
 
     Returns
     -------
@@ -211,7 +227,8 @@ def labels(
     affine, spacing, origin = _placement(affine, spacing, origin)
     _mode(mode)
     verts, faces, face_labels, meshes, stats = _native.labels(
-        volume, spacing, origin, background, mode, bool(pad), bool(normals), threads, selection,
+        volume, spacing, origin, background, mode, bool(pad), bool(normals), threads,
+        _smoothing(smoothing), selection,
         None if affine is None else affine[:3].tolist(), space,
     )
     if face_labels.dtype != dtype:
