@@ -29,15 +29,21 @@ pub(super) fn merge<L: Label>(
     }
     let mut gone_vertex = vec![false; atlas.positions.len()];
     let mut gone_triangle = vec![false; atlas.triangles.len()];
-    for group in around(&ears, atlas.positions.len()) {
+    let groups = around(&ears, atlas.positions.len());
+    // Each ear is one grey vertex's, so the decisions are independent: made on threads, applied
+    // in order.
+    let decide = |group: &[u32; 4]| {
         let [a, b, c, d] = group.map(|e| &ears[e as usize]);
-        let group = [a, b, c, d];
         let w = a.background;
         let allowed = [b, c, d].iter().all(|e| e.background == w)
             && (params.mode == Mode::Paper
-                || group.iter().all(|e| e.mergeable) && !blocks(grid, a.lower, a.axis, w));
-        let pair = allowed.then(|| quad(atlas, [a, b, c, d])).flatten();
-        let Some([first, second]) = pair else {
+                || [a, b, c, d].iter().all(|e| e.mergeable) && !blocks(grid, a.lower, a.axis, w));
+        allowed.then(|| quad(atlas, [a, b, c, d])).flatten()
+    };
+    let decisions: Vec<Option<[[u32; 3]; 2]>> = decide_all(&groups, decide, params.threads);
+    for (group, decision) in groups.iter().zip(decisions) {
+        let [a, b, c, d] = group.map(|e| &ears[e as usize]);
+        let Some([first, second]) = decision else {
             atlas.stats.blocked += 1;
             continue;
         };
@@ -49,6 +55,27 @@ pub(super) fn merge<L: Label>(
         atlas.stats.merged += 1;
     }
     Some(compact(atlas, &gone_vertex, &gone_triangle))
+}
+
+/// `decide` for every group, on threads unless one was asked for.
+#[cfg(feature = "std")]
+fn decide_all<T: Send>(
+    groups: &[[u32; 4]],
+    decide: impl Fn(&[u32; 4]) -> T + Sync,
+    threads: usize,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    if threads == 1 {
+        groups.iter().map(decide).collect()
+    } else {
+        groups.par_iter().map(&decide).collect()
+    }
+}
+
+/// `decide` for every group.
+#[cfg(not(feature = "std"))]
+fn decide_all<T>(groups: &[[u32; 4]], decide: impl Fn(&[u32; 4]) -> T, _threads: usize) -> Vec<T> {
+    groups.iter().map(decide).collect()
 }
 
 /// The ears of each grey vertex with four, by ascending vertex, each group in the order the ears

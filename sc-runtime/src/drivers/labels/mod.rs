@@ -123,19 +123,42 @@ pub fn extract_labels<L: Label>(
     } else {
         Vec::new()
     };
-    let pieces = sweep_pieces(&grid, params, ranges)?;
-    let (mut atlas, ears, mut edges, mut pinned) = join::join(pieces);
-    atlas.stats.v13 = atlas.positions.len() as u64;
-    atlas.stats.t13 = atlas.triangles.len() as u64;
-    if let Some(kept) = merge::merge(&grid, params, ears, &mut atlas) {
-        renumber(&mut edges, &mut pinned, &kept);
+    on_threads(params.threads, || {
+        let pieces = sweep_pieces(&grid, params, ranges)?;
+        let (mut atlas, ears, mut edges, mut pinned) = join::join(pieces);
+        atlas.stats.v13 = atlas.positions.len() as u64;
+        atlas.stats.t13 = atlas.triangles.len() as u64;
+        if let Some(kept) = merge::merge(&grid, params, ears, &mut atlas) {
+            renumber(&mut edges, &mut pinned, &kept);
+        }
+        if params.smoothing > 0.0 {
+            smooth::place(&grid, params, &mut atlas, &edges, &pinned);
+        }
+        atlas.stats.vertices = atlas.positions.len() as u64;
+        atlas.stats.triangles = atlas.triangles.len() as u64;
+        Ok(atlas)
+    })?
+}
+
+/// Runs `job` where Rayon's threads are the number asked for: its global pool when it has
+/// them (starting a pool costs a noticeable share of a small volume's extraction), a pool of
+/// its own otherwise; one thread runs on the caller's and sweeps nothing in parallel.
+#[cfg(feature = "std")]
+fn on_threads<R: Send>(threads: usize, job: impl FnOnce() -> R + Send) -> Result<R, Error> {
+    if threads == 0 || threads == 1 || threads == rayon::current_num_threads() {
+        return Ok(job());
     }
-    if params.smoothing > 0.0 {
-        smooth::place(&grid, params, &mut atlas, &edges, &pinned);
-    }
-    atlas.stats.vertices = atlas.positions.len() as u64;
-    atlas.stats.triangles = atlas.triangles.len() as u64;
-    Ok(atlas)
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|_| Error::ThreadPool)?;
+    Ok(pool.install(job))
+}
+
+/// Runs `job` on this thread.
+#[cfg(not(feature = "std"))]
+fn on_threads<R>(_threads: usize, job: impl FnOnce() -> R) -> Result<R, Error> {
+    Ok(job())
 }
 
 /// `edges` and `pinned` after the merge dropped vertices: `kept[v]` is vertex `v`'s new id,
@@ -161,7 +184,7 @@ fn renumber(edges: &mut Vec<sweep::Edge>, pinned: &mut Vec<u32>, kept: &[u32]) {
 /// threads share a small volume evenly.
 const PIECE_LAYERS: usize = 16;
 
-/// The pieces of `ranges`, in order, on the threads asked for.
+/// The pieces of `ranges`, in order, on the pool [`on_threads`] chose.
 #[cfg(feature = "std")]
 fn sweep_pieces<L: Label>(
     grid: &Padded<'_, L>,
@@ -169,27 +192,16 @@ fn sweep_pieces<L: Label>(
     ranges: Vec<Range<usize>>,
 ) -> Result<Vec<sweep::Piece<L>>, Error> {
     use rayon::prelude::*;
-    let run = || {
-        ranges
-            .par_iter()
-            .map(|r| sweep::sweep(grid, params, r.clone()))
-            .collect()
-    };
-    match params.threads {
-        1 => ranges
+    if params.threads == 1 {
+        return ranges
             .into_iter()
             .map(|r| sweep::sweep(grid, params, r))
-            .collect(),
-        // Rayon's global pool when it has the threads asked for: starting a pool costs a
-        // noticeable share of a small volume's extraction.
-        0 => run(),
-        n if n == rayon::current_num_threads() => run(),
-        n => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|_| Error::ThreadPool)?
-            .install(run),
+            .collect();
     }
+    ranges
+        .par_iter()
+        .map(|r| sweep::sweep(grid, params, r.clone()))
+        .collect()
 }
 
 /// The pieces of `ranges`, in order, on this thread.
