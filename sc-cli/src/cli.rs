@@ -404,6 +404,9 @@ fn mode_help(mode: Mode) -> &'static str {
         Mode::Embedded => "Steps 1–4, merging where the surface stays a closed 2-manifold",
         Mode::Paper => "Steps 1–4, merging every interior grey edge, as the paper does",
         Mode::Steps123 => "Steps 1–3 only: no merging",
+        Mode::Adaptive => {
+            "Steps 1–3 with boxes of 2³ cubes meshed as one within --max-error (0.5 voxel by default); one thread, no --stream or --shards"
+        }
     }
 }
 

@@ -53,6 +53,7 @@ pub fn mode_name(mode: Mode) -> &'static str {
         Mode::Embedded => "Steps 1–4, embedded",
         Mode::Paper => "Steps 1–4, paper",
         Mode::Steps123 => "Steps 1–3",
+        Mode::Adaptive => "Adaptive",
     }
 }
 
@@ -131,7 +132,16 @@ impl fmt::Display for Summary {
             thousands(s.v13),
             thousands(s.t13)
         )?;
-        if self.mode != Mode::Steps123 {
+        if self.mode == Mode::Adaptive {
+            writeln!(
+                f,
+                "  {:<22}{:>12}{:>12}   {:.1} % fewer triangles",
+                mode_name(self.mode),
+                thousands(s.vertices),
+                thousands(s.triangles),
+                s.reduction_percent(),
+            )?;
+        } else if self.mode != Mode::Steps123 {
             writeln!(
                 f,
                 "  {:<22}{:>12}{:>12}   {:.1} % fewer triangles ({} grey edges merged)",

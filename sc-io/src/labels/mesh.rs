@@ -82,7 +82,11 @@ pub struct LabelMeshes {
 }
 
 /// Meshes the labels `request` selects in `grid`: an integer volume, read as stored.
-pub fn extract(grid: &Grid, request: &LabelRequest, progress: &dyn Progress) -> Result<LabelMeshes> {
+pub fn extract(
+    grid: &Grid,
+    request: &LabelRequest,
+    progress: &dyn Progress,
+) -> Result<LabelMeshes> {
     if !grid.scale.is_identity() {
         return Err(Error::Usage(format!(
             "--labels: the volume rescales its samples (slope {}, intercept {}); labels are \
@@ -123,14 +127,21 @@ where
 {
     let name = grid.samples.dtype().name();
     let background = L::try_from(request.background).map_err(|_| {
-        Error::Usage(format!("--background {} does not fit the volume's {name} samples", request.background))
+        Error::Usage(format!(
+            "--background {} does not fit the volume's {name} samples",
+            request.background
+        ))
     })?;
     let params = LabelParams {
         background,
         mode: request.mode,
         pad: true,
         spacing: grid.spacing,
-        origin: if world.is_translation() { world.offset } else { [0.0; 3] },
+        origin: if world.is_translation() {
+            world.offset
+        } else {
+            [0.0; 3]
+        },
         threads: request.threads,
         ..LabelParams::default()
     };
@@ -151,16 +162,35 @@ where
     if let Selection::Only(ranges) = &request.selection {
         let missing: Vec<String> = ranges
             .iter()
-            .filter(|r| !present.iter().any(|&l| id(l).is_some_and(|i| r.contains(&i))))
-            .map(|r| if r.start() == r.end() { r.start().to_string() } else { format!("{}-{}", r.start(), r.end()) })
+            .filter(|r| {
+                !present
+                    .iter()
+                    .any(|&l| id(l).is_some_and(|i| r.contains(&i)))
+            })
+            .map(|r| {
+                if r.start() == r.end() {
+                    r.start().to_string()
+                } else {
+                    format!("{}-{}", r.start(), r.end())
+                }
+            })
             .collect();
         if !missing.is_empty() {
-            let some: Vec<String> = present.iter().take(12).filter_map(|&l| id(l)).map(|i| i.to_string()).collect();
+            let some: Vec<String> = present
+                .iter()
+                .take(12)
+                .filter_map(|&l| id(l))
+                .map(|i| i.to_string())
+                .collect();
             return Err(Error::Usage(format!(
                 "--labels: no sample holds {} (present: {}{})",
                 missing.join(", "),
                 some.join(", "),
-                if present.len() > some.len() { ", …" } else { "" }
+                if present.len() > some.len() {
+                    ", …"
+                } else {
+                    ""
+                }
             )));
         }
     }
@@ -175,7 +205,10 @@ where
         .into_iter()
         .filter_map(|(l, mesh)| Some((id(l)?, mesh)))
         .collect();
-    Ok(LabelMeshes { meshes, stats: atlas.stats })
+    Ok(LabelMeshes {
+        meshes,
+        stats: atlas.stats,
+    })
 }
 
 #[cfg(test)]
