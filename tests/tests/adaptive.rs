@@ -359,7 +359,16 @@ fn bad_options_are_refused() {
         };
         assert_eq!(extract(&volume, &p), Err(Error::MaxError), "{bad}");
     }
-    for (given, ok) in [(0, false), (1, true), (2, true), (3, false), (4, false)] {
+    // 15 cubes along each axis: boxes up to 8.
+    for (given, ok) in [
+        (0, false),
+        (1, true),
+        (2, true),
+        (3, false),
+        (8, true),
+        (12, false),
+        (16, false),
+    ] {
         let p = Params {
             max_box: Some(given),
             ..base
@@ -367,7 +376,7 @@ fn bad_options_are_refused() {
         let got = extract(&volume, &p);
         assert_eq!(got.is_ok(), ok, "max_box {given}");
         if !ok {
-            assert_eq!(got, Err(Error::MaxBox { given, largest: 2 }));
+            assert_eq!(got, Err(Error::MaxBox { given, largest: 8 }));
         }
     }
     // A box of one cube is Steps 1–3.

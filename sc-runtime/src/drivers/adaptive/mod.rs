@@ -16,10 +16,10 @@ use alloc::vec::Vec;
 use crate::drivers::borrowed::sweep_into;
 use crate::drivers::has_cubes;
 use crate::kernel::Binary;
-use crate::kernel::adaptive::checks::Patch;
+use crate::kernel::adaptive::checks::scaled;
 use crate::kernel::adaptive::outline::Shape;
 use crate::kernel::adaptive::{
-    BoxSource, Crossing, Metric, SIDE, Vertex, accept, outline, triangulate,
+    BoxSource, Crossing, Metric, Vertex, accept, outline, triangulate,
 };
 use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
@@ -36,8 +36,8 @@ fn default_bound(params: &Params) -> ErrorBound {
     ErrorBound::World(0.5 * least)
 }
 
-/// The largest box adaptive mode makes, in cubes.
-pub(crate) const LARGEST_BOX: u32 = SIDE as u32;
+/// The largest box adaptive mode makes, in cubes, and its default.
+pub(crate) const LARGEST_BOX: u32 = 16;
 
 /// Checks adaptive mode's options: the bound finite and at least zero, the box a power of two no
 /// larger than the volume's longest cube count and no larger than the boxes this version makes.
@@ -84,8 +84,9 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
         t13: stats.t13,
         ..Stats::default()
     };
-    let side = params.max_box.unwrap_or(LARGEST_BOX) as usize;
-    if !has_cubes(dims) || side < SIDE {
+    let largest = params.max_box.unwrap_or(LARGEST_BOX);
+    let levels = largest.ilog2() as usize;
+    if !has_cubes(dims) || levels == 0 {
         mesh.stats.vertices = mesh.positions.len() as u64;
         mesh.stats.triangles = mesh.triangles.len() as u64;
         return Ok(mesh);
@@ -99,9 +100,15 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
         limit: bound.value(),
     };
     let grid = Grid::new(volume, params.iso, &rec, &mesh.triangles);
-    let cells = dims.map(|d| (d - 1) / SIDE);
-    let boxes = grid.decide(cells, &metric);
-    let triangles = grid.emit(cells, &boxes, &metric);
+    let lattice = grid.decide(levels, &metric);
+    let triangles = match lattice.first() {
+        Some((pairs, _)) => {
+            let mut level = final_levels(&lattice);
+            balance(&mut level, *pairs, dims);
+            grid.emit(&lattice, &level, &metric)
+        }
+        None => mesh.triangles.clone(),
+    };
     drop(grid);
     mesh.triangles = triangles;
     compact(&mut mesh);
@@ -110,16 +117,19 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
     Ok(mesh)
 }
 
-/// A box on the lattice: whether it replaces its unit cubes.
+/// A box on the lattice of its size: whether it may replace its cubes.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Cell {
-    /// Its unit cubes keep their Steps 1–3 triangles.
+    /// It may not: its cubes, or its children, stay.
     Cubes,
-    /// No occupied edge: a box that emits nothing.
+    /// No occupied edge in it: a box that emits nothing.
     Empty,
-    /// A box that emits its own triangles.
+    /// A box that may emit its own triangles, in any variant.
     Box,
 }
+
+/// Per box size `2^ℓ`, from `ℓ = 1`: the boxes along each axis, and each one's decision.
+type Lattice = Vec<([usize; 3], Vec<Cell>)>;
 
 /// The volume, its Steps 1–3 mesh and the lookups the boxes need.
 struct Grid<'a, T: Scalar> {
@@ -185,12 +195,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
     /// A vertex's place in grid steps, from its edge key.
     fn place(&self, key: u64) -> [f64; 3] {
         let axis = (key % 3) as usize;
-        let point = (key / 3) as usize;
-        let lower = [
-            point % self.dims[0],
-            point / self.dims[0] % self.dims[1],
-            point / (self.dims[0] * self.dims[1]),
-        ];
+        let lower = unkey((key / 3) as usize, self.dims);
         let mut upper = lower;
         upper[axis] += 1;
         let t = sample_crossing(self.sample(lower), self.sample(upper), self.iso);
@@ -204,97 +209,215 @@ impl<'a, T: Scalar> Grid<'a, T> {
         &self.by_cube[lo..hi]
     }
 
-    /// Decides every box of the lattice, `cells` boxes along each axis.
-    fn decide(&self, cells: [usize; 3], metric: &Metric) -> Vec<Cell> {
-        let mut boxes = vec![Cell::Cubes; cells.iter().product()];
-        for cz in 0..cells[2] {
-            for cy in 0..cells[1] {
-                for cx in 0..cells[0] {
-                    let cell = [cx, cy, cz];
-                    let corner = cell.map(|c| c * SIDE);
-                    boxes[cell_index(cell, cells)] = match outline(self, corner) {
-                        Shape::Empty => Cell::Empty,
-                        Shape::Complex => Cell::Cubes,
-                        Shape::Simple(o) => {
-                            let may_chord = (0..o.n).fold(0u8, |m, i| {
-                                let face = usize::from(o.arc_face[i]);
-                                match neighbour(cell, face, cells) {
-                                    Some(_) => m | 1 << i,
-                                    None => m,
-                                }
-                            });
-                            let patch = Patch::new(self, corner, metric);
-                            if accept(self, &o, may_chord, &patch, metric) {
-                                Cell::Box
-                            } else {
-                                Cell::Cubes
-                            }
-                        }
-                    };
+    /// The Steps 1–3 triangles of the box of `side` at `corner`, in the metric's units.
+    fn patch(&self, corner: [usize; 3], side: usize, metric: &Metric, out: &mut Vec<[[f64; 3]; 3]>) {
+        out.clear();
+        for dz in 0..side {
+            for dy in 0..side {
+                for dx in 0..side {
+                    let cube = [corner[0] + dx, corner[1] + dy, corner[2] + dz];
+                    self.cube_triangles(cube, &mut |t| out.push(t.map(|p| scaled(p, metric))));
                 }
             }
         }
-        boxes
     }
 
-    /// The triangles: those of unit cubes outside boxes, in sweep order, then each box's in the
-    /// variant its neighbours give it.
-    fn emit(&self, cells: [usize; 3], boxes: &[Cell], metric: &Metric) -> Vec<[u32; 3]> {
-        let cell_of = |cube_key: u64| -> Option<usize> {
-            let k = cube_key as usize;
-            let cube = [
-                k % self.dims[0],
-                k / self.dims[0] % self.dims[1],
-                k / (self.dims[0] * self.dims[1]),
-            ];
-            let cell = cube.map(|c| c / SIDE);
-            (0..3)
-                .all(|d| cell[d] < cells[d])
-                .then(|| cell_index(cell, cells))
+    /// Decides the boxes of every size up to `2^levels`, smallest first: a box is tested only if
+    /// its eight children may all be boxes.
+    fn decide(&self, levels: usize, metric: &Metric) -> Lattice {
+        let mut lattice: Lattice = Vec::new();
+        let mut patch = Vec::new();
+        for level in 1..=levels {
+            let side = 1 << level;
+            let cells = self.dims.map(|d| (d - 1) / side);
+            if cells.contains(&0) {
+                break;
+            }
+            let mut states = vec![Cell::Cubes; cells.iter().product()];
+            for (i, state) in states.iter_mut().enumerate() {
+                let cell = unkey(i, cells);
+                if let Some((below, children)) = lattice.last() {
+                    let whole = (0..8).all(|k| {
+                        let child: [usize; 3] = core::array::from_fn(|d| 2 * cell[d] + (k >> d & 1));
+                        children[cell_index(child, *below)] != Cell::Cubes
+                    });
+                    if !whole {
+                        continue;
+                    }
+                }
+                let corner = cell.map(|c| c * side);
+                *state = match outline(self, corner, side) {
+                    Shape::Empty => Cell::Empty,
+                    Shape::Complex => Cell::Cubes,
+                    Shape::Simple(o) => {
+                        let may_chord = (0..o.n).fold(0u8, |m, i| {
+                            match neighbour(cell, usize::from(o.arc_face[i]), cells) {
+                                Some(_) => m | 1 << i,
+                                None => m,
+                            }
+                        });
+                        self.patch(corner, side, metric, &mut patch);
+                        if accept(self, &o, may_chord, &patch, metric) {
+                            Cell::Box
+                        } else {
+                            Cell::Cubes
+                        }
+                    }
+                };
+            }
+            lattice.push((cells, states));
+        }
+        lattice
+    }
+
+    /// The triangles: those of unit cubes outside boxes, in sweep order, then each box's, size
+    /// by size, in the variant its neighbours give it. `level` is the balanced size of the box
+    /// holding each pair of cubes (`final_levels`).
+    fn emit(&self, lattice: &Lattice, level: &[u8], metric: &Metric) -> Vec<[u32; 3]> {
+        let pairs = lattice[0].0;
+        let in_box = |cube_key: u64| -> bool {
+            let pair = unkey(cube_key as usize, self.dims).map(|c| c / 2);
+            (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
         let mut out: Vec<[u32; 3]> = self
             .triangles
             .iter()
             .zip(self.cubes)
-            .filter(|&(_, &c)| c == u64::MAX || cell_of(c).is_none_or(|i| boxes[i] != Cell::Box))
+            .filter(|&(_, &c)| c == u64::MAX || !in_box(c))
             .map(|(&t, _)| t)
             .collect();
-        for cz in 0..cells[2] {
-            for cy in 0..cells[1] {
-                for cx in 0..cells[0] {
-                    let cell = [cx, cy, cz];
-                    if boxes[cell_index(cell, cells)] != Cell::Box {
-                        continue;
+        let mut patch = Vec::new();
+        for (l, (cells, states)) in lattice.iter().enumerate() {
+            let (l, side) = (l as u8 + 1, 2usize << l);
+            for (i, &state) in states.iter().enumerate() {
+                let cell = unkey(i, *cells);
+                let first = cell.map(|c| c * (side / 2));
+                if state != Cell::Box || level[cell_index(first, pairs)] != l {
+                    continue;
+                }
+                let corner = cell.map(|c| c * side);
+                let Shape::Simple(o) = outline(self, corner, side) else {
+                    continue;
+                };
+                // A face keeps its midline vertices unless a box at least as large is across.
+                let refined = (0..o.n).fold(0u8, |m, i| {
+                    let face = usize::from(o.arc_face[i]);
+                    match across(first, side / 2, face, pairs) {
+                        Some(j) if level[j] >= l => m,
+                        _ => m | 1 << i,
                     }
-                    let corner = cell.map(|c| c * SIDE);
-                    let Shape::Simple(o) = outline(self, corner) else {
-                        continue;
-                    };
-                    let refined = (0..o.n).fold(0u8, |m, i| {
-                        let face = usize::from(o.arc_face[i]);
-                        match neighbour(cell, face, cells) {
-                            Some(j) if boxes[j] != Cell::Cubes => m,
-                            _ => m | 1 << i,
-                        }
-                    });
-                    let patch = Patch::new(self, corner, metric);
-                    // Accepted boxes triangulate in every variant (`accept`), and the choice
-                    // depends on the box and its variant alone.
-                    let Some(t) = triangulate(self, &o, refined, &patch, metric) else {
-                        debug_assert!(false, "an accepted box failed its variant");
-                        continue;
-                    };
-                    for tri in t.triangles() {
-                        let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
-                        if let [Some(a), Some(b), Some(c)] = ids {
-                            out.push([a, b, c]);
-                        }
+                });
+                self.patch(corner, side, metric, &mut patch);
+                // Accepted boxes triangulate in every variant (`accept`), and the choice
+                // depends on the box and its variant alone.
+                let Some(t) = triangulate(self, &o, refined, &patch, metric) else {
+                    debug_assert!(false, "an accepted box failed its variant");
+                    continue;
+                };
+                for tri in t.triangles() {
+                    let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
+                    if let [Some(a), Some(b), Some(c)] = ids {
+                        out.push([a, b, c]);
                     }
                 }
             }
         }
         out
     }
+}
+
+/// Per pair of cubes (the boxes of side 2), the level of the largest box holding it that may be
+/// one (0: none, its cubes stay).
+fn final_levels(lattice: &Lattice) -> Vec<u8> {
+    let pairs = lattice[0].0;
+    let mut level = vec![0u8; pairs.iter().product()];
+    for (l, (cells, states)) in lattice.iter().enumerate() {
+        let span = 1usize << l;
+        for (i, &state) in states.iter().enumerate() {
+            if state == Cell::Cubes {
+                continue;
+            }
+            let cell = unkey(i, *cells);
+            for k in 0..span * span * span {
+                let pair: [usize; 3] =
+                    core::array::from_fn(|d| cell[d] * span + k / span.pow(d as u32) % span);
+                level[cell_index(pair, pairs)] = l as u8 + 1;
+            }
+        }
+    }
+    level
+}
+
+/// Splits boxes until no box has a face neighbour less than half its side (the unique minimal
+/// 2:1 refinement). Every child of a box was accepted before it, in every variant, so a split
+/// never leaves an untested box. Cubes past the last pair of a volume with an odd number of
+/// cubes along an axis are unit cubes.
+fn balance(level: &mut [u8], pairs: [usize; 3], dims: [usize; 3]) {
+    loop {
+        let mut changed = false;
+        for i in 0..level.len() {
+            let l = level[i];
+            let first = unkey(i, pairs);
+            let span = 1usize << l.saturating_sub(1);
+            if l < 2 || first.iter().any(|&c| c % span != 0) {
+                continue;
+            }
+            let too_small = (0..6).any(|face| {
+                let (axis, high) = (face / 2, face % 2 == 1);
+                let at = if high {
+                    first[axis] + span
+                } else if first[axis] == 0 {
+                    return false;
+                } else {
+                    first[axis] - 1
+                };
+                if at >= pairs[axis] {
+                    // Unit cubes past the last pair, if the grid has any.
+                    return 2 * pairs[axis] < dims[axis] - 1;
+                }
+                let [a, b] = [(axis + 1) % 3, (axis + 2) % 3];
+                (0..span * span).any(|k| {
+                    let mut p = first;
+                    p[axis] = at;
+                    p[a] += k % span;
+                    p[b] += k / span;
+                    level[cell_index(p, pairs)] + 1 < l
+                })
+            });
+            if too_small {
+                for k in 0..span * span * span {
+                    let pair: [usize; 3] =
+                        core::array::from_fn(|d| first[d] + k / span.pow(d as u32) % span);
+                    level[cell_index(pair, pairs)] = l - 1;
+                }
+                changed = true;
+            }
+        }
+        if !changed {
+            return;
+        }
+    }
+}
+
+/// The pair of cubes across face `face` (`2 · axis + side`) of the box whose first pair is
+/// `first` and which spans `span` pairs, if that pair exists.
+fn across(first: [usize; 3], span: usize, face: usize, pairs: [usize; 3]) -> Option<usize> {
+    let (axis, high) = (face / 2, face % 2 == 1);
+    let mut p = first;
+    if high {
+        p[axis] += span;
+        if p[axis] >= pairs[axis] {
+            return None;
+        }
+    } else {
+        p[axis] = p[axis].checked_sub(1)?;
+    }
+    Some(cell_index(p, pairs))
+}
+
+/// The point of a grid of `dims` with index `i`, x fastest.
+fn unkey(i: usize, dims: [usize; 3]) -> [usize; 3] {
+    [i % dims[0], i / dims[0] % dims[1], i / (dims[0] * dims[1])]
 }
 
 impl<T: Scalar> BoxSource for Grid<'_, T> {

@@ -6,7 +6,7 @@
 //! costs triangles.
 
 use super::outline::{Outline, on_line, others};
-use super::{BoxSource, MAX_POLYGON, Metric, SIDE, Vertex};
+use super::{BoxSource, MAX_POLYGON, Metric, Vertex};
 use crate::geometry::point_triangle_distance_squared;
 use crate::kernel::vertex::root::sqrt;
 
@@ -124,17 +124,17 @@ pub(crate) fn separates(
     refined: u8,
     tris: &[[Vertex; 3]],
 ) -> bool {
-    let corner = outline.corner;
+    let (corner, side) = (outline.corner, outline.side);
     for axis in 0..3 {
         let [o1, o2] = others(axis);
-        for u in 0..=SIDE {
-            for v in 0..=SIDE {
-                let (edge_u, edge_v) = (u % SIDE == 0, v % SIDE == 0);
+        for u in 0..=side {
+            for v in 0..=side {
+                let (edge_u, edge_v) = (u % side == 0, v % side == 0);
                 if edge_u && edge_v {
                     continue;
                 }
                 // The line's occupied edge, if any ((S): at most one).
-                let want = (0..SIDE).find_map(|k| {
+                let want = (0..side).find_map(|k| {
                     let lower = on_line(corner, axis, [u, v], k);
                     src.crossing(lower, axis).map(|_| lower[axis])
                 });
@@ -142,9 +142,9 @@ pub(crate) fn separates(
                 let mut hits = [0.0; 2];
                 let count = if edge_u || edge_v {
                     let face = if edge_u {
-                        2 * o1 + u / SIDE
+                        2 * o1 + u / side
                     } else {
-                        2 * o2 + v / SIDE
+                        2 * o2 + v / side
                     };
                     // The coordinate across the line within the face.
                     let (w, w_at) = if edge_u { (o2, at[1]) } else { (o1, at[0]) };
@@ -320,55 +320,23 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     sqrt(e[0] * e[0] + e[1] * e[1])
 }
 
-/// The Steps 1–3 triangles of a box, scaled by the metric.
-pub(crate) struct Patch {
-    tris: [[[f64; 3]; 3]; super::MAX_STEPS123],
-    n: usize,
-}
-
-impl Patch {
-    /// The Steps 1–3 triangles of the box at `corner`.
-    pub fn new(src: &impl BoxSource, corner: [usize; 3], metric: &Metric) -> Patch {
-        let mut patch = Patch {
-            tris: [[[0.0; 3]; 3]; super::MAX_STEPS123],
-            n: 0,
-        };
-        for dz in 0..SIDE {
-            for dy in 0..SIDE {
-                for dx in 0..SIDE {
-                    let cube = [corner[0] + dx, corner[1] + dy, corner[2] + dz];
-                    src.cube_triangles(cube, &mut |t| {
-                        if patch.n < patch.tris.len() {
-                            patch.tris[patch.n] = t.map(|p| scaled(p, metric));
-                            patch.n += 1;
-                        }
-                    });
-                }
-            }
-        }
-        patch
-    }
-
-    fn tris(&self) -> &[[[f64; 3]; 3]] {
-        &self.tris[..self.n]
-    }
-}
-
+/// A point in grid steps, in the metric's units.
 #[inline]
-fn scaled(p: [f64; 3], metric: &Metric) -> [f64; 3] {
+pub(crate) fn scaled(p: [f64; 3], metric: &Metric) -> [f64; 3] {
     core::array::from_fn(|d| p[d] * metric.scale[d])
 }
 
-/// (E): the box's triangles and the Steps 1–3 triangles of the box lie within the bound of each
-/// other, every point of each (not only sampled ones): see [`within`].
-pub(crate) fn within_bound(tris: &[[Vertex; 3]], patch: &Patch, metric: &Metric) -> bool {
+/// (E): the box's triangles and the Steps 1–3 triangles of the box (`patch`, in the metric's
+/// units) lie within the bound of each other, every point of each (not only sampled ones): see
+/// [`within`].
+pub(crate) fn within_bound(tris: &[[Vertex; 3]], patch: &[[[f64; 3]; 3]], metric: &Metric) -> bool {
     let mut ours = [[[0.0; 3]; 3]; super::MAX_TRIANGLES];
     for (i, t) in tris.iter().enumerate() {
         ours[i] = t.map(|v| scaled(v.p, metric));
     }
     let ours = &ours[..tris.len()];
-    ours.iter().all(|&t| within(t, patch.tris(), metric.limit))
-        && patch.tris().iter().all(|&t| within(t, ours, metric.limit))
+    ours.iter().all(|&t| within(t, patch, metric.limit))
+        && patch.iter().all(|&t| within(t, ours, metric.limit))
 }
 
 /// Whether every point of triangle `t` lies within `limit` of one of `others`. The distance to

@@ -1,5 +1,5 @@
-//! Adaptive mode's per-box rules (docs/adaptive.md): which boxes of 2×2×2 cubes may replace
-//! their Steps 1–3 triangles, and the triangles they emit.
+//! Adaptive mode's per-box rules (docs/adaptive.md): which boxes of `s × s × s` cubes (`s` a
+//! power of two) may replace their Steps 1–3 triangles, and the triangles they emit.
 //!
 //! `no_std` and allocation-free. A box reads its samples' crossings and its unit cubes'
 //! Steps 1–3 triangles through [`BoxSource`]; the driver (`drivers/adaptive`) decides every
@@ -18,11 +18,6 @@ pub(crate) mod triangulate;
 pub(crate) use outline::outline;
 pub(crate) use triangulate::{accept, triangulate};
 
-/// The side of a box, in cubes. Boxes of one size only: balance across faces is then
-/// automatic (a box's neighbour is a box of its size or unit cubes), and each face has one
-/// midline per direction.
-pub(crate) const SIDE: usize = 2;
-
 /// The most corner vertices a loop can have: one per face it crosses.
 pub(crate) const MAX_CORNERS: usize = 6;
 /// Midline vertices per face: one per midline, two midlines.
@@ -31,8 +26,6 @@ pub(crate) const MAX_MIDS: usize = 2;
 pub(crate) const MAX_POLYGON: usize = MAX_CORNERS * (1 + MAX_MIDS);
 /// The most triangles a box emits: a polygon of `MAX_POLYGON` vertices, triangulated.
 pub(crate) const MAX_TRIANGLES: usize = MAX_POLYGON - 2;
-/// The most Steps 1–3 triangles in a box: five per unit cube.
-pub(crate) const MAX_STEPS123: usize = 5 * SIDE * SIDE * SIDE;
 
 /// An occupied unit edge's crossing (SPEC §1): where along the edge, and which way.
 #[derive(Clone, Copy, Debug)]
@@ -68,15 +61,15 @@ pub(crate) struct Vertex {
 }
 
 impl Vertex {
-    /// The vertex of the occupied unit edge from `lower` along `axis`, placed in the box whose
-    /// lower corner is `corner`.
-    fn new(lower: [usize; 3], axis: usize, c: Crossing, corner: [usize; 3]) -> Vertex {
+    /// The vertex of the occupied unit edge from `lower` along `axis`, placed in the box of side
+    /// `side` whose lower corner is `corner`.
+    fn new(lower: [usize; 3], axis: usize, c: Crossing, corner: [usize; 3], side: usize) -> Vertex {
         let mut faces = 0;
         for n in 0..3 {
             if n != axis {
                 if lower[n] == corner[n] {
                     faces |= 1 << (2 * n);
-                } else if lower[n] == corner[n] + SIDE {
+                } else if lower[n] == corner[n] + side {
                     faces |= 1 << (2 * n + 1);
                 }
             }

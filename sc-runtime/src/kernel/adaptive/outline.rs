@@ -8,7 +8,7 @@
 //! in between. The loop is oriented as the surface is (filled → empty), from the crossings'
 //! direction along the axis that has the most of them.
 
-use super::{BoxSource, MAX_CORNERS, MAX_MIDS, SIDE, Vertex};
+use super::{BoxSource, MAX_CORNERS, MAX_MIDS, Vertex};
 use crate::kernel::adaptive::checks::double_area;
 
 /// A box's loop: its corner vertices in order, and per arc (from corner `i` to corner `i + 1`,
@@ -17,6 +17,8 @@ use crate::kernel::adaptive::checks::double_area;
 pub(crate) struct Outline {
     /// The box's lower corner, in samples.
     pub corner: [usize; 3],
+    /// The box's side, in cubes.
+    pub side: usize,
     /// Corner vertices, in the loop's order.
     pub corners: [Vertex; MAX_CORNERS],
     /// How many corners (3 to 6).
@@ -68,25 +70,26 @@ pub(crate) fn on_line(corner: [usize; 3], axis: usize, [u, v]: [usize; 2], k: us
 fn line_vertex(
     src: &impl BoxSource,
     corner: [usize; 3],
+    side: usize,
     axis: usize,
     uv: [usize; 2],
 ) -> Option<Vertex> {
-    (0..SIDE).find_map(|k| {
+    (0..side).find_map(|k| {
         let lower = on_line(corner, axis, uv, k);
         src.crossing(lower, axis)
-            .map(|c| Vertex::new(lower, axis, c, corner))
+            .map(|c| Vertex::new(lower, axis, c, corner, side))
     })
 }
 
-/// Runs (S) on the box at `corner` and traces its loop.
-pub(crate) fn outline(src: &impl BoxSource, corner: [usize; 3]) -> Shape {
+/// Runs (S) on the box of side `side` at `corner` and traces its loop.
+pub(crate) fn outline(src: &impl BoxSource, corner: [usize; 3], side: usize) -> Shape {
     let mut totals = [0usize; 3];
     let mut dirs: [Option<bool>; 3] = [None; 3];
     for axis in 0..3 {
-        for u in 0..=SIDE {
-            for v in 0..=SIDE {
+        for u in 0..=side {
+            for v in 0..=side {
                 let mut count = 0;
-                for k in 0..SIDE {
+                for k in 0..side {
                     if let Some(c) = src.crossing(on_line(corner, axis, [u, v], k), axis) {
                         count += 1;
                         match dirs[axis] {
@@ -106,15 +109,15 @@ pub(crate) fn outline(src: &impl BoxSource, corner: [usize; 3]) -> Shape {
     if totals == [0; 3] {
         return Shape::Empty;
     }
-    // Box edges: along `axis` at (u, v) ∈ {0, SIDE}², numbered 4 · axis + u/SIDE + 2 · v/SIDE.
-    let edge_uv = |e: usize| [(e & 1) * SIDE, (e >> 1 & 1) * SIDE];
+    // Box edges: along `axis` at (u, v) ∈ {0, side}², numbered 4 · axis + u/side + 2 · v/side.
+    let edge_uv = |e: usize| [(e & 1) * side, (e >> 1 & 1) * side];
     let edge_vertex: [Option<Vertex>; 12] =
-        core::array::from_fn(|e| line_vertex(src, corner, e / 4, edge_uv(e % 4)));
+        core::array::from_fn(|e| line_vertex(src, corner, side, e / 4, edge_uv(e % 4)));
     // The two faces (2 · axis + side) each box edge lies on.
     let edge_faces = |e: usize| {
         let [o1, o2] = others(e / 4);
         let [u, v] = edge_uv(e % 4);
-        [2 * o1 + u / SIDE, 2 * o2 + v / SIDE]
+        [2 * o1 + u / side, 2 * o2 + v / side]
     };
     // Each face's crossed box edges: none or two.
     let mut face_ends = [[usize::MAX; 2]; 6];
@@ -138,6 +141,7 @@ pub(crate) fn outline(src: &impl BoxSource, corner: [usize; 3]) -> Shape {
     };
     let mut out = Outline {
         corner,
+        side,
         corners: [Vertex::default(); MAX_CORNERS],
         n: 0,
         arc_face: [0; MAX_CORNERS],
@@ -201,18 +205,18 @@ pub(crate) fn outline(src: &impl BoxSource, corner: [usize; 3]) -> Shape {
 /// coordinates' sum, each signed toward the arc's end.
 fn face_mids(src: &impl BoxSource, out: &Outline, i: usize) -> (u8, [Vertex; MAX_MIDS]) {
     let face = usize::from(out.arc_face[i]);
-    let (normal, side) = (face / 2, face % 2);
+    let (normal, high, s) = (face / 2, face % 2, out.side);
     let mut mids = [Vertex::default(); MAX_MIDS];
     let mut count = 0;
     for axis in others(normal) {
         // The line along `axis` through the middle of the face.
         let [o1, _] = others(axis);
         let uv = if o1 == normal {
-            [side * SIDE, SIDE / 2]
+            [high * s, s / 2]
         } else {
-            [SIDE / 2, side * SIDE]
+            [s / 2, high * s]
         };
-        if let Some(w) = line_vertex(src, out.corner, axis, uv) {
+        if let Some(w) = line_vertex(src, out.corner, s, axis, uv) {
             mids[count] = w;
             count += 1;
         }

@@ -10,7 +10,7 @@
 //! function of the box's samples and its variant alone.
 
 use super::checks::{
-    Patch, faces_up, in_wall, quality, separates, simple_projection, within_bound,
+    faces_up, in_wall, quality, separates, simple_projection, within_bound,
 };
 use super::outline::Outline;
 use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Metric, Vertex};
@@ -120,47 +120,81 @@ fn best_fan(
     best
 }
 
-/// The box's triangles in the variant `refined`, if some triangulation passes every test.
+/// The refined triangles of coarse triangulation `coarse`, with its worst triangle's quality,
+/// if every small polygon has a fan that faces up with no triangle in a face.
+fn refine(outline: &Outline, refined: u8, coarse: &[[u8; 3]]) -> Option<(Triangulation, f64)> {
+    let mut out = Triangulation {
+        tris: [[Vertex::default(); 3]; MAX_TRIANGLES],
+        n: 0,
+    };
+    let mut worst = f64::INFINITY;
+    for &tri in coarse {
+        let (q, len) = refined_boundary(outline, refined, tri);
+        let (fan, count, w) = best_fan(outline, &q[..len])?;
+        worst = worst.min(w);
+        for &t in &fan[..count] {
+            if !out.push(t) {
+                return None;
+            }
+        }
+    }
+    Some((out, worst))
+}
+
+/// The most coarse triangulations of a corner polygon: 14, of a hexagon.
+const MAX_COARSE: usize = 14;
+
+/// The box's triangles in the variant `refined`, if some triangulation passes every test: of
+/// those that do, the one whose worst triangle is best shaped. Candidates are refined and
+/// ranked first, then tested best first, so (P) and (E), the costly tests, usually run once.
+/// `patch` is the box's Steps 1–3 triangles in the metric's units.
 pub(crate) fn triangulate(
     src: &impl BoxSource,
     outline: &Outline,
     refined: u8,
-    patch: &Patch,
+    patch: &[[[f64; 3]; 3]],
     metric: &Metric,
 ) -> Option<Triangulation> {
     let (polygon, m) = outline.polygon(refined);
     if !simple_projection(&polygon[..m], outline.axis) {
         return None;
     }
-    let mut best: Option<(f64, Triangulation)> = None;
+    // (quality, enumeration index) of each candidate whose fans exist.
+    let mut ranked = [(0.0, 0u8); MAX_COARSE];
+    let (mut n, mut index) = (0, 0u8);
     each_coarse(outline.n, &mut |coarse| {
-        let mut out = Triangulation {
-            tris: [[Vertex::default(); 3]; MAX_TRIANGLES],
-            n: 0,
-        };
-        let mut worst = f64::INFINITY;
-        for &tri in coarse {
-            let (q, len) = refined_boundary(outline, refined, tri);
-            let Some((fan, count, w)) = best_fan(outline, &q[..len]) else {
-                return;
-            };
-            worst = worst.min(w);
-            for &t in &fan[..count] {
-                if !out.push(t) {
-                    return;
-                }
-            }
+        if let Some((_, worst)) = refine(outline, refined, coarse) {
+            ranked[n] = (worst, index);
+            n += 1;
         }
-        if best.as_ref().is_some_and(|b| worst <= b.0) {
-            return;
-        }
-        if separates(src, outline, refined, out.triangles())
-            && within_bound(out.triangles(), patch, metric)
-        {
-            best = Some((worst, out));
-        }
+        index += 1;
     });
-    best.map(|(_, t)| t)
+    // Best shaped first; on a tie, the first enumerated (a stable sort, by hand: n ≤ 14).
+    let ranked = &mut ranked[..n];
+    for i in 1..ranked.len() {
+        let mut j = i;
+        while j > 0 && ranked[j].0 > ranked[j - 1].0 {
+            ranked.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+    for &(_, wanted) in ranked.iter() {
+        let mut found = None;
+        let mut index = 0u8;
+        each_coarse(outline.n, &mut |coarse| {
+            if index == wanted {
+                found = refine(outline, refined, coarse).map(|(t, _)| t);
+            }
+            index += 1;
+        });
+        let Some(t) = found else { continue };
+        if separates(src, outline, refined, t.triangles())
+            && within_bound(t.triangles(), patch, metric)
+        {
+            return Some(t);
+        }
+    }
+    None
 }
 
 /// Whether the box can be emitted in every variant its neighbours may give it: bit `i` of
@@ -169,7 +203,7 @@ pub(crate) fn accept(
     src: &impl BoxSource,
     outline: &Outline,
     may_chord: u8,
-    patch: &Patch,
+    patch: &[[[f64; 3]; 3]],
     metric: &Metric,
 ) -> bool {
     let with_mids = (0..outline.n)
