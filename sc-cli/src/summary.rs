@@ -157,11 +157,18 @@ impl fmt::Display for Summary {
                 ErrorBound::World(d) => (d, "world units"),
                 ErrorBound::Voxels(d) => (d, "voxels"),
             };
-            writeln!(
-                f,
-                "  --max-error {d} {units}: {} more grey edges kept to stay within it",
-                thousands(s.bounded)
-            )?;
+            if self.mode == Mode::Adaptive {
+                writeln!(
+                    f,
+                    "  --max-error {d} {units}: the surface stays within it of Steps 1–3's"
+                )?;
+            } else {
+                writeln!(
+                    f,
+                    "  --max-error {d} {units}: {} more grey edges kept to stay within it",
+                    thousands(s.bounded)
+                )?;
+            }
         }
         if let Some(ours) = self.paper_knot {
             let [mc, t13, t14] = PAPER_KNOT.map(thousands);

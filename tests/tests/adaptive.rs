@@ -404,3 +404,40 @@ fn bad_options_are_refused() {
         Err(Error::NotAdaptive { .. })
     ));
 }
+
+/// Boxes larger than two cubes grow and are kept: on the torus, `max_box` 16 gives fewer
+/// triangles than 2, and some triangle side is longer than any in a box of two cubes (its
+/// diagonal, 2√3 grid steps). Every check of `holds` runs on this volume and bound above, with
+/// `max_box` 16.
+#[test]
+fn larger_boxes_grow() {
+    let vol = volumes::demo(demo::torus(48));
+    let params = |max_box| Params {
+        max_box: Some(max_box),
+        ..adaptive_params(&vol, ErrorBound::Voxels(1.0))
+    };
+    let longest = |m: &Mesh| -> f64 {
+        let grid = |i: u32| -> P {
+            let p = m.positions[i as usize];
+            std::array::from_fn(|d| (f64::from(p[d]) - vol.origin[d]) / vol.spacing[d])
+        };
+        m.triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(a, b)| {
+                let (a, b) = (grid(a), grid(b));
+                (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>().sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    let (small, large) = (run(&vol, &params(2)), run(&vol, &params(16)));
+    let diagonal = 2.0 * 3f64.sqrt();
+    assert!(longest(&small) <= diagonal + 1e-4, "{}", longest(&small));
+    assert!(longest(&large) > diagonal, "{}", longest(&large));
+    assert!(large.triangles.len() < small.triangles.len());
+    println!(
+        "torus 48³ at 1 voxel: max_box 2 {} triangles, 16 {}",
+        small.triangles.len(),
+        large.triangles.len()
+    );
+}

@@ -18,9 +18,7 @@ use crate::drivers::has_cubes;
 use crate::kernel::Binary;
 use crate::kernel::adaptive::checks::scaled;
 use crate::kernel::adaptive::outline::Shape;
-use crate::kernel::adaptive::{
-    BoxSource, Crossing, Metric, Vertex, accept, outline, triangulate,
-};
+use crate::kernel::adaptive::{BoxSource, Crossing, Metric, Vertex, accept, outline, triangulate};
 use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
 use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume};
@@ -210,7 +208,13 @@ impl<'a, T: Scalar> Grid<'a, T> {
     }
 
     /// The Steps 1–3 triangles of the box of `side` at `corner`, in the metric's units.
-    fn patch(&self, corner: [usize; 3], side: usize, metric: &Metric, out: &mut Vec<[[f64; 3]; 3]>) {
+    fn patch(
+        &self,
+        corner: [usize; 3],
+        side: usize,
+        metric: &Metric,
+        out: &mut Vec<[[f64; 3]; 3]>,
+    ) {
         out.clear();
         for dz in 0..side {
             for dy in 0..side {
@@ -238,7 +242,8 @@ impl<'a, T: Scalar> Grid<'a, T> {
                 let cell = unkey(i, cells);
                 if let Some((below, children)) = lattice.last() {
                     let whole = (0..8).all(|k| {
-                        let child: [usize; 3] = core::array::from_fn(|d| 2 * cell[d] + (k >> d & 1));
+                        let child: [usize; 3] =
+                            core::array::from_fn(|d| 2 * cell[d] + (k >> d & 1));
                         children[cell_index(child, *below)] != Cell::Cubes
                     });
                     if !whole {

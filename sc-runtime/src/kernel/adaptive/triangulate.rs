@@ -9,9 +9,7 @@
 //! triangle is best shaped is taken, the first in enumeration order on a tie, so the choice is a
 //! function of the box's samples and its variant alone.
 
-use super::checks::{
-    faces_up, in_wall, quality, separates, simple_projection, within_bound,
-};
+use super::checks::{faces_up, in_wall, quality, separates, simple_projection, within_bound};
 use super::outline::Outline;
 use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Metric, Vertex};
 
