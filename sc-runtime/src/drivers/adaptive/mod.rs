@@ -2,13 +2,15 @@
 //!
 //! 1. The Steps 1–3 mesh is swept as [`Mode::Steps123`](crate::Mode::Steps123) makes it, each
 //!    vertex named by its grid edge and each triangle by its cube ([`record`]).
-//! 2. Every box of 2×2×2 cubes on the lattice of even samples is decided on its own samples and
-//!    Steps 1–3 triangles: empty, refused (it stays eight unit cubes), or accepted because it
-//!    passes (S), (F), (P) and (E) in every variant its neighbours could give it
-//!    ([`crate::kernel::adaptive`]).
-//! 3. The unit cubes outside accepted boxes keep their Steps 1–3 triangles; each accepted box
-//!    emits its triangles in the variant its neighbours do give it, and the vertices no
-//!    triangle uses any more are dropped.
+//! 2. Boxes of side 2, 4, … up to `max_box`, on the lattice of multiples of their side, are
+//!    decided smallest first on their own samples and Steps 1–3 triangles: empty, refused, or
+//!    accepted because their eight children may be boxes and they pass (S), (F), (P) and (E) in
+//!    every variant their neighbours could give them ([`crate::kernel::adaptive`]).
+//! 3. The largest accepted box over each pair of cubes is kept, and boxes are split until no
+//!    face neighbour is less than half their side.
+//! 4. The unit cubes outside boxes keep their Steps 1–3 triangles; each box emits its
+//!    triangles in the variant its neighbours do give it, and the vertices no triangle uses any
+//!    more are dropped.
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -146,20 +148,17 @@ struct Grid<'a, T: Scalar> {
 
 impl<'a, T: Scalar> Grid<'a, T> {
     fn new(volume: &Volume<'a, T>, iso: f64, rec: &'a Recorded, triangles: &'a [[u32; 3]]) -> Self {
-        let mut vertex_of: Vec<(u64, u32)> = rec
-            .edges
-            .iter()
-            .enumerate()
-            .map(|(i, &k)| (k, i as u32))
-            .collect();
-        vertex_of.sort_unstable();
-        let mut by_cube: Vec<(u64, u32)> = rec
-            .cubes
-            .iter()
-            .enumerate()
-            .map(|(i, &k)| (k, i as u32))
-            .collect();
-        by_cube.sort_unstable();
+        // Each key with its index, in key order.
+        let sorted = |keys: &[u64]| -> Vec<(u64, u32)> {
+            let mut v: Vec<(u64, u32)> = keys
+                .iter()
+                .enumerate()
+                .map(|(i, &k)| (k, i as u32))
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        let (vertex_of, by_cube) = (sorted(&rec.edges), sorted(&rec.cubes));
         Grid {
             data: volume.data(),
             dims: volume.dims(),

@@ -1,13 +1,14 @@
 //! A box's triangles in one variant (docs/adaptive.md §3).
 //!
-//! A face of the box keeps its arc's midline vertices iff the box on the other side is not a box
-//! of the same size (unit cubes there have those vertices on their edges); bit `i` of `refined`
-//! says so for arc `i`. The corner polygon (3 to 6 vertices) is triangulated in each of its 1,
+//! A face of the box keeps its arc's midline vertices unless a box at least as large is across
+//! it (the smaller boxes or unit cubes across have those vertices on their edges); bit `i` of
+//! `refined` says so for arc `i`. The corner polygon (3 to 6 vertices) is triangulated in each of its 1,
 //! 2, 5 or 14 ways; in each, a coarse triangle whose sides include kept midline vertices becomes
 //! a small polygon, fanned from the one of its vertices that gives the best-shaped triangles
 //! with none lying in a face. Of the candidates that pass (F), (P) and (E), the one whose worst
 //! triangle is best shaped is taken, the first in enumeration order on a tie, so the choice is a
-//! function of the box's samples and its variant alone.
+//! function of the box's samples and its variant alone: the variant tested when the box was
+//! accepted is the one emitted.
 
 use super::checks::{faces_up, in_wall, quality, separates, simple_projection, within_bound};
 use super::outline::Outline;
