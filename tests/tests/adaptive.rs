@@ -10,6 +10,7 @@
 
 use std::collections::{HashMap, HashSet};
 
+use sc_runtime::labels::{LabelParams, extract_labels};
 use sc_runtime::{Error, ErrorBound, Mesh, Mode, Params, Volume, demo, extract, extract_par};
 use sc_tests::checks::{assert_closed_manifold, assert_no_self_intersections};
 use sc_tests::geometry::{point_triangle_distance, solid_angle};
@@ -396,6 +397,15 @@ fn bad_options_are_refused() {
     };
     assert!(matches!(
         extract(&volume, &p),
+        Err(Error::NotAdaptive { .. })
+    ));
+    let labels = [0u8, 1, 1, 0, 0, 1, 1, 0];
+    let label_params = LabelParams {
+        mode: Mode::Adaptive,
+        ..LabelParams::default()
+    };
+    assert!(matches!(
+        extract_labels(Volume::new(&labels, [2, 2, 2]).unwrap(), &label_params),
         Err(Error::NotAdaptive { .. })
     ));
     let cubes = [0..15, 0..15, 0..15];
