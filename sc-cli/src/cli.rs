@@ -266,7 +266,8 @@ pub struct ExtractArgs {
     /// bound on how far Step 4 moves the surface, in the volume's world units (mm for most
     /// scans) or, with `--error-units voxels`, in grid steps.
     /// 0 merges nothing (Steps 1–3's triangles); no bound (the default) merges what the mode
-    /// allows.
+    /// allows. In adaptive mode, the largest distance between its surface and Steps 1–3's, both
+    /// ways (default: half the smallest spacing).
     #[arg(long, value_parser = parse_max_error)]
     pub max_error: Option<f64>,
     /// The units of `--max-error`.
@@ -410,6 +411,9 @@ fn mode_help(mode: Mode) -> &'static str {
         Mode::Embedded => "Steps 1–4, merging where the surface stays a closed 2-manifold",
         Mode::Paper => "Steps 1–4, merging every interior grey edge, as the paper does",
         Mode::Steps123 => "Steps 1–3 only: no merging",
+        Mode::Adaptive => {
+            "Steps 1–3 with boxes of up to 16³ cubes meshed as one within --max-error (0.5 voxel by default), every sample kept on its side; one thread, no --stream or --shards"
+        }
     }
 }
 

@@ -53,6 +53,7 @@ pub fn mode_name(mode: Mode) -> &'static str {
         Mode::Embedded => "Steps 1–4, embedded",
         Mode::Paper => "Steps 1–4, paper",
         Mode::Steps123 => "Steps 1–3",
+        Mode::Adaptive => "Adaptive",
     }
 }
 
@@ -131,7 +132,16 @@ impl fmt::Display for Summary {
             thousands(s.v13),
             thousands(s.t13)
         )?;
-        if self.mode != Mode::Steps123 {
+        if self.mode == Mode::Adaptive {
+            writeln!(
+                f,
+                "  {:<22}{:>12}{:>12}   {:.1} % fewer triangles",
+                mode_name(self.mode),
+                thousands(s.vertices),
+                thousands(s.triangles),
+                s.reduction_percent(),
+            )?;
+        } else if self.mode != Mode::Steps123 {
             writeln!(
                 f,
                 "  {:<22}{:>12}{:>12}   {:.1} % fewer triangles ({} grey edges merged)",
@@ -147,11 +157,18 @@ impl fmt::Display for Summary {
                 ErrorBound::World(d) => (d, "world units"),
                 ErrorBound::Voxels(d) => (d, "voxels"),
             };
-            writeln!(
-                f,
-                "  --max-error {d} {units}: {} more grey edges kept to stay within it",
-                thousands(s.bounded)
-            )?;
+            if self.mode == Mode::Adaptive {
+                writeln!(
+                    f,
+                    "  --max-error {d} {units}: the surface stays within it of Steps 1–3's"
+                )?;
+            } else {
+                writeln!(
+                    f,
+                    "  --max-error {d} {units}: {} more grey edges kept to stay within it",
+                    thousands(s.bounded)
+                )?;
+            }
         }
         if let Some(ours) = self.paper_knot {
             let [mc, t13, t14] = PAPER_KNOT.map(thousands);

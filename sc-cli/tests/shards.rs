@@ -453,7 +453,7 @@ fn a_manifest_s_names_and_numbers_are_checked() {
         (
             "/settings/mode",
             "fast".into(),
-            "mode \"fast\": expected 'embedded', 'paper' or 'steps123'",
+            "mode \"fast\": expected 'embedded', 'paper', 'steps123' or 'adaptive'",
         ),
         (
             "/settings/iso",

@@ -77,7 +77,7 @@ def test_a_non_finite_number_in_a_shard_is_refused_naming_it(shards, array, valu
     (("world", "offset", 0), "a", r'world: offset \["a",'),
     (("settings", "spacing", 2), 1e30, "below 1e30"),
     (("settings", "mode", None), "fastest",
-     "mode \"fastest\": expected 'embedded', 'paper' or 'steps123'"),
+     "mode \"fastest\": expected 'embedded', 'paper', 'steps123' or 'adaptive'"),
 ])
 def test_a_manifest_s_numbers_and_names_are_checked(shards, at, value, message):
     manifest, _ = shards

@@ -307,10 +307,11 @@ def extract(
         Without an affine, vertex positions are ``index × spacing + origin`` (by default
         ``(1, 1, 1)`` and ``(0, 0, 0)``). Beside an affine they must agree with its column
         lengths and translation.
-    mode : ``"embedded"`` (default), ``"paper"`` or ``"steps123"``
+    mode : ``"embedded"`` (default), ``"paper"``, ``"steps123"`` or ``"adaptive"``
         ``embedded`` merges only where the surface stays a closed 2-manifold, ``paper`` merges
         every interior grey edge as the paper does, ``steps123`` does not merge (the Marching
-        Cubes triangle count).
+        Cubes triangle count), ``adaptive`` meshes boxes of 2³ cubes as one where they stay
+        within ``max_error`` of the Steps 1–3 surface (one thread; not for blocks or Dask).
     pad : bool
         Surround the volume with one layer of empty samples (a copy), so every surface is
         closed; positions stay in the unpadded volume's coordinates.

@@ -198,6 +198,10 @@ pub fn extract_block<T: Scalar>(
     cubes: [Range<usize>; 3],
     params: &Params,
 ) -> Result<BlockMesh, Error> {
+    super::not_adaptive(
+        params,
+        "extract_block does not run adaptive mode yet (use extract)",
+    )?;
     sweep_block(&Binary::new(params), samples, at, grid, cubes, params)
 }
 

@@ -30,6 +30,10 @@ pub fn extract_into<T: Scalar>(
     scratch: Scratch<'_>,
     sink: &mut impl Sink,
 ) -> Result<Stats, Error> {
+    super::not_adaptive(
+        params,
+        "extract_into does not run adaptive mode: its boxes read the whole Steps 1–3 mesh (use extract)",
+    )?;
     sweep_into(&Binary::new(params), volume, params, scratch, sink)
 }
 

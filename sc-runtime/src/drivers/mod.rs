@@ -10,11 +10,13 @@
 //! - [`stream`]: slices pushed one at a time through a ring of four (`SliceStreamer`).
 
 use crate::kernel::Slices;
-use crate::{Scalar, Volume};
+use crate::{Error, Mode, Params, Scalar, Volume};
 
 pub(crate) mod borrowed;
 pub(crate) mod stream;
 
+#[cfg(feature = "alloc")]
+pub(crate) mod adaptive;
 #[cfg(feature = "alloc")]
 pub(crate) mod blocks;
 #[cfg(feature = "alloc")]
@@ -57,6 +59,20 @@ impl<T> Slices<T> for InMemory<'_, T> {
             .get(z * self.nxy..(z + 1) * self.nxy)
             .unwrap_or(&[])
     }
+}
+
+/// Refuses adaptive mode, with `entry`'s reason, in an entry point that does not run it, and
+/// adaptive mode's option in every other mode.
+pub(crate) fn not_adaptive(params: &Params, entry: &'static str) -> Result<(), Error> {
+    if params.mode == Mode::Adaptive {
+        return Err(Error::NotAdaptive { what: entry });
+    }
+    if params.max_box.is_some() {
+        return Err(Error::NotAdaptive {
+            what: "max_box needs adaptive mode",
+        });
+    }
+    Ok(())
 }
 
 /// Whether the grid has any cube: dims below 2 on an axis give an empty mesh.

@@ -7,7 +7,7 @@ use crate::drivers::survey::Survey;
 use crate::drivers::{InMemory, has_cubes};
 use crate::kernel::{Binary, Engine};
 use crate::mesh::{OwnedScratch, Presized};
-use crate::{Error, Mesh, Params, Scalar, Stats, Volume};
+use crate::{Error, Mesh, Mode, Params, Scalar, Stats, Volume};
 
 /// Extracts on one thread into buffers it keeps from one call to the next: for an iso slider, a
 /// time series, or any loop that meshes volumes of one size again and again.
@@ -46,6 +46,11 @@ impl Extractor {
         volume: &Volume<'_, T>,
         params: &Params,
     ) -> Result<&Mesh, Error> {
+        if params.mode == Mode::Adaptive {
+            self.mesh = super::adaptive::extract(volume, params)?;
+            return Ok(&self.mesh);
+        }
+        super::not_adaptive(params, "")?;
         self.sweep(&Binary::new(params), volume, params)
     }
 
@@ -97,6 +102,10 @@ impl Extractor {
 /// assert_eq!(mesh.stats.t13, 13_968); // the paper's Table 1, Steps 1–3
 /// ```
 pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
+    if params.mode == Mode::Adaptive {
+        return super::adaptive::extract(volume, params);
+    }
+    super::not_adaptive(params, "")?;
     sweep(&Binary::new(params), volume, params)
 }
 

@@ -54,6 +54,10 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
         ring: &'s mut [T],
         sink: S,
     ) -> Result<Self, Error> {
+        super::not_adaptive(
+            params,
+            "SliceStreamer does not run adaptive mode: its boxes read the whole Steps 1–3 mesh (use extract)",
+        )?;
         Scratch::len(dims)?;
         if ring.len() < Self::ring_len(dims) {
             return Err(Error::ScratchTooSmall);

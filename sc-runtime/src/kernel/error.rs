@@ -64,6 +64,21 @@ pub enum Error {
     /// A label extraction's smoothing width is negative, not finite, or wider than
     /// [`MAX_SMOOTHING`](crate::labels::MAX_SMOOTHING) voxels.
     Smoothing,
+    /// `max_error` is negative, NaN or infinite.
+    MaxError,
+    /// `max_box` is not a power of two from 1 to `largest`.
+    MaxBox {
+        /// The box asked for, in cubes.
+        given: u32,
+        /// The largest box allowed on this volume, in cubes.
+        largest: u32,
+    },
+    /// `max_box` given to a mode that makes no boxes, or adaptive mode asked of an entry point
+    /// that does not run it: `what` names it.
+    NotAdaptive {
+        /// The option or entry point.
+        what: &'static str,
+    },
     /// The joined blocks do not cover the grid.
     BlocksMissing {
         /// Cubes the blocks own.
@@ -122,6 +137,12 @@ impl fmt::Display for Error {
                 "the smoothing width is in voxels, from 0 (none) to {}",
                 crate::kernel::labels::MAX_SMOOTHING
             ),
+            Error::MaxError => f.write_str("max_error must be a finite number ≥ 0"),
+            Error::MaxBox { given, largest } => write!(
+                f,
+                "max_box must be a power of two from 1 to {largest} (1, 2, 4, …), got {given}"
+            ),
+            Error::NotAdaptive { what } => f.write_str(what),
             Error::BlocksMissing { covered, cubes } => write!(
                 f,
                 "the joined blocks cover {covered} of the grid's {cubes} cubes"

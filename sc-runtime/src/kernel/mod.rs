@@ -4,6 +4,9 @@
 //! ([`Scratch`](crate::Scratch)) and hands vertices and triangles to a [`Sink`](crate::Sink).
 //! What it needs of the drivers, and what they may rely on, is in [`engine`].
 
+// Allocation-free itself, but only the allocating driver runs it (`drivers/adaptive`).
+#[cfg(feature = "alloc")]
+pub(crate) mod adaptive;
 pub(crate) mod engine;
 pub(crate) mod error;
 pub mod geometry;

@@ -36,15 +36,19 @@ pub enum Mode {
     Paper,
     /// Steps 1–3 only: the Marching-Cubes-sized surface, no merging.
     Steps123,
+    /// Steps 1–3, with boxes of 2×2×2 cubes meshed as one where the surface through them is
+    /// simple, stays within [`Params::max_error`] of the Steps 1–3 surface and keeps every
+    /// sample on its side (docs/adaptive.md). One thread, the volume in memory.
+    Adaptive,
 }
 
 impl Mode {
     /// Every mode, in declaration order.
-    pub const ALL: [Mode; 3] = [Mode::Embedded, Mode::Paper, Mode::Steps123];
+    pub const ALL: [Mode; 4] = [Mode::Embedded, Mode::Paper, Mode::Steps123, Mode::Adaptive];
 
     /// The modes' names, in the order of [`Mode::ALL`]: the one spelling that the command
     /// line, Python, shard manifests and reports share.
-    pub const NAMES: [&'static str; 3] = ["embedded", "paper", "steps123"];
+    pub const NAMES: [&'static str; 4] = ["embedded", "paper", "steps123", "adaptive"];
 
     /// This mode's name (see [`Mode::NAMES`]).
     pub const fn name(self) -> &'static str {
@@ -187,6 +191,10 @@ pub struct Params {
     /// The bound on Step 4's displacement of the surface; `None` (the default) merges whatever
     /// the mode allows, and a bound of zero merges nothing.
     pub max_error: Option<ErrorBound>,
+    /// Adaptive mode's largest box, in cubes along each side: a power of two from 1 up to the
+    /// largest this version makes (2) and the volume's longest cube count; `None` (the default)
+    /// is that largest. 1 keeps every unit cube, the Steps 1–3 mesh. Other modes refuse it.
+    pub max_box: Option<u32>,
     /// The case tables; [`crate::tables::DEFAULT`] unless a crate brings its own.
     pub tables: &'static crate::tables::CaseTables,
 }
@@ -204,6 +212,7 @@ impl Params {
             origin: [0.0; 3],
             axes: Axes::Xyz,
             max_error: None,
+            max_box: None,
             tables: &crate::tables::DEFAULT,
         }
     }
@@ -263,7 +272,10 @@ mod tests {
         }
         let e = "Paper".parse::<Mode>().unwrap_err();
         assert_eq!(e.expected(), &Mode::NAMES[..]);
-        assert_eq!(e.to_string(), "expected 'embedded', 'paper' or 'steps123'");
+        assert_eq!(
+            e.to_string(),
+            "expected 'embedded', 'paper', 'steps123' or 'adaptive'"
+        );
         let e = "mm".parse::<ErrorUnits>().unwrap_err();
         assert_eq!(e.to_string(), "expected 'world' or 'voxels'");
     }

@@ -76,12 +76,12 @@ impl CaseTables {
         self.mergeable
     }
 
-    /// The table a mode reads.
+    /// The table a mode reads; adaptive mode's unit cubes are Steps 1–3's.
     #[inline]
     pub fn for_mode(&self, mode: crate::Mode) -> &'static [Entry; 2048] {
         match mode {
             crate::Mode::Paper => self.paper,
-            crate::Mode::Embedded | crate::Mode::Steps123 => self.embedded,
+            crate::Mode::Embedded | crate::Mode::Steps123 | crate::Mode::Adaptive => self.embedded,
         }
     }
 }

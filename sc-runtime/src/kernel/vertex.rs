@@ -63,7 +63,7 @@ fn weights(a: f64, b: f64, iso: f64) -> [f64; 2] {
 /// Square roots: `std`'s where it is linked, which compile to one instruction the optimiser sees
 /// through; `libm`'s (the same correctly rounded results) otherwise.
 #[cfg(feature = "std")]
-mod root {
+pub(crate) mod root {
     #[inline(always)]
     pub fn sqrt(x: f64) -> f64 {
         x.sqrt()
@@ -75,7 +75,7 @@ mod root {
     }
 }
 #[cfg(not(feature = "std"))]
-mod root {
+pub(crate) mod root {
     pub use libm::{sqrt, sqrtf};
 }
 use root::{sqrt, sqrtf};

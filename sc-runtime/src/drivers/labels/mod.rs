@@ -113,6 +113,11 @@ pub fn extract_labels<L: Label>(
     if !(0.0..=MAX_SMOOTHING).contains(&params.smoothing) {
         return Err(Error::Smoothing);
     }
+    if params.mode == Mode::Adaptive {
+        return Err(Error::NotAdaptive {
+            what: "label volumes have no adaptive mode (use embedded, paper or steps123)",
+        });
+    }
     let grid = Padded::new(volume, params);
     let layers = grid.n[2].saturating_sub(1);
     let ranges: Vec<Range<usize>> = if grid.n.iter().all(|&n| n >= 2) {

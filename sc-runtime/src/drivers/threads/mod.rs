@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use claims::{Claims, Progress};
 use region::{Filled, Stretch};
 
+use crate::Mode;
 use crate::drivers::reuse;
 use crate::drivers::spare::SPARES;
 use crate::drivers::survey::{self, Survey};
@@ -121,6 +122,12 @@ pub fn extract_par<T: Scalar>(
     threads: usize,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Mesh, Error> {
+    if params.mode == Mode::Adaptive {
+        let mesh = super::adaptive::extract(volume, params)?;
+        progress(volume.dims()[2].saturating_sub(1));
+        return Ok(mesh);
+    }
+    super::not_adaptive(params, "")?;
     sweep_par(&Binary::new(params), volume, params, threads, progress)
 }
 

@@ -1,0 +1,500 @@
+//! Adaptive mode's driver: one thread, the volume in memory (docs/adaptive.md).
+//!
+//! 1. The Steps 1–3 mesh is swept as [`Mode::Steps123`](crate::Mode::Steps123) makes it, each
+//!    vertex named by its grid edge and each triangle by its cube ([`record`]).
+//! 2. Boxes of side 2, 4, … up to `max_box`, on the lattice of multiples of their side, are
+//!    decided smallest first on their own samples and Steps 1–3 triangles: empty, refused, or
+//!    accepted because their eight children may be boxes and they pass (S), (F), (P) and (E) in
+//!    every variant their neighbours could give them ([`crate::kernel::adaptive`]).
+//! 3. The largest accepted box over each pair of cubes is kept, and boxes are split until no
+//!    face neighbour is less than half their side.
+//! 4. The unit cubes outside boxes keep their Steps 1–3 triangles; each box emits its
+//!    triangles in the variant its neighbours do give it, and the vertices no triangle uses any
+//!    more are dropped.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use crate::drivers::borrowed::sweep_into;
+use crate::drivers::has_cubes;
+use crate::kernel::Binary;
+use crate::kernel::adaptive::checks::scaled;
+use crate::kernel::adaptive::outline::Shape;
+use crate::kernel::adaptive::{BoxSource, Crossing, Metric, Vertex, accept, outline, triangulate};
+use crate::kernel::vertex::sample_crossing;
+use crate::mesh::OwnedScratch;
+use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume};
+
+mod record;
+
+use record::Recorded;
+
+/// The bound adaptive mode holds when none is given: half the smallest spacing, in world units
+/// (half a voxel where the spacing is even).
+fn default_bound(params: &Params) -> ErrorBound {
+    let least = params.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+    ErrorBound::World(0.5 * least)
+}
+
+/// The largest box adaptive mode makes, in cubes, and its default.
+pub(crate) const LARGEST_BOX: u32 = 16;
+
+/// Checks adaptive mode's options: the bound finite and at least zero, the box a power of two no
+/// larger than the volume's longest cube count and no larger than the boxes this version makes.
+pub(crate) fn check(params: &Params, dims: [usize; 3]) -> Result<(), Error> {
+    if let Some(b) = params.max_error
+        && !(b.value().is_finite() && b.value() >= 0.0)
+    {
+        return Err(Error::MaxError);
+    }
+    if let Some(given) = params.max_box {
+        let cubes = dims.iter().map(|&d| d.saturating_sub(1)).max().unwrap_or(0);
+        let volume = u32::try_from(cubes).unwrap_or(u32::MAX);
+        let largest = LARGEST_BOX.min(if volume == 0 { 1 } else { 1 << volume.ilog2() });
+        if given == 0 || !given.is_power_of_two() || given > largest {
+            return Err(Error::MaxBox { given, largest });
+        }
+    }
+    Ok(())
+}
+
+/// Extracts the adaptive mesh of `volume` (see the module's steps).
+pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
+    let dims = volume.dims();
+    check(params, dims)?;
+    let steps123 = Params {
+        mode: Mode::Steps123,
+        max_error: None,
+        max_box: None,
+        ..*params
+    };
+    let mut rec = Recorded::new(dims);
+    let mut scratch = OwnedScratch::new(dims)?;
+    let stats = sweep_into(
+        &Binary::new(&steps123),
+        volume,
+        &steps123,
+        scratch.lend(),
+        &mut rec,
+    )?;
+    drop(scratch);
+    let mut mesh = core::mem::take(&mut rec.mesh);
+    mesh.stats = Stats {
+        v13: stats.v13,
+        t13: stats.t13,
+        ..Stats::default()
+    };
+    let largest = params.max_box.unwrap_or(LARGEST_BOX);
+    let levels = largest.ilog2() as usize;
+    if !has_cubes(dims) || levels == 0 {
+        mesh.stats.vertices = mesh.positions.len() as u64;
+        mesh.stats.triangles = mesh.triangles.len() as u64;
+        return Ok(mesh);
+    }
+    let bound = params.max_error.unwrap_or_else(|| default_bound(params));
+    let metric = Metric {
+        scale: match bound {
+            ErrorBound::World(_) => params.spacing,
+            ErrorBound::Voxels(_) => [1.0; 3],
+        },
+        limit: bound.value(),
+    };
+    let grid = Grid::new(volume, params.iso, &rec, &mesh.triangles);
+    let lattice = grid.decide(levels, &metric);
+    let triangles = match lattice.first() {
+        Some((pairs, _)) => {
+            let mut level = final_levels(&lattice);
+            balance(&mut level, *pairs, dims);
+            grid.emit(&lattice, &level, &metric)
+        }
+        None => mesh.triangles.clone(),
+    };
+    drop(grid);
+    mesh.triangles = triangles;
+    compact(&mut mesh);
+    mesh.stats.vertices = mesh.positions.len() as u64;
+    mesh.stats.triangles = mesh.triangles.len() as u64;
+    Ok(mesh)
+}
+
+/// A box on the lattice of its size: whether it may replace its cubes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Cell {
+    /// It may not: its cubes, or its children, stay.
+    Cubes,
+    /// No occupied edge in it: a box that emits nothing.
+    Empty,
+    /// A box that may emit its own triangles, in any variant.
+    Box,
+}
+
+/// Per box size `2^ℓ`, from `ℓ = 1`: the boxes along each axis, and each one's decision.
+type Lattice = Vec<([usize; 3], Vec<Cell>)>;
+
+/// The volume, its Steps 1–3 mesh and the lookups the boxes need.
+struct Grid<'a, T: Scalar> {
+    data: &'a [T],
+    dims: [usize; 3],
+    iso: f64,
+    threshold: T::Threshold,
+    /// Vertex edge keys with their ids, sorted by key.
+    vertex_of: Vec<(u64, u32)>,
+    /// Triangle ids sorted by their cube's key, with those keys.
+    by_cube: Vec<(u64, u32)>,
+    triangles: &'a [[u32; 3]],
+    edges: &'a [u64],
+    cubes: &'a [u64],
+}
+
+impl<'a, T: Scalar> Grid<'a, T> {
+    fn new(volume: &Volume<'a, T>, iso: f64, rec: &'a Recorded, triangles: &'a [[u32; 3]]) -> Self {
+        // Each key with its index, in key order.
+        let sorted = |keys: &[u64]| -> Vec<(u64, u32)> {
+            let mut v: Vec<(u64, u32)> = keys
+                .iter()
+                .enumerate()
+                .map(|(i, &k)| (k, i as u32))
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        let (vertex_of, by_cube) = (sorted(&rec.edges), sorted(&rec.cubes));
+        Grid {
+            data: volume.data(),
+            dims: volume.dims(),
+            iso,
+            threshold: T::threshold(iso),
+            vertex_of,
+            by_cube,
+            triangles,
+            edges: &rec.edges,
+            cubes: &rec.cubes,
+        }
+    }
+
+    fn key(&self, p: [usize; 3]) -> u64 {
+        (p[0] + self.dims[0] * (p[1] + self.dims[1] * p[2])) as u64
+    }
+
+    fn sample(&self, p: [usize; 3]) -> T {
+        self.data[p[0] + self.dims[0] * (p[1] + self.dims[1] * p[2])]
+    }
+
+    fn vertex_id(&self, lower: [usize; 3], axis: usize) -> Option<u32> {
+        let key = 3 * self.key(lower) + axis as u64;
+        let i = self.vertex_of.partition_point(|&(k, _)| k < key);
+        self.vertex_of
+            .get(i)
+            .filter(|&&(k, _)| k == key)
+            .map(|&(_, id)| id)
+    }
+
+    /// A vertex's place in grid steps, from its edge key.
+    fn place(&self, key: u64) -> [f64; 3] {
+        let axis = (key % 3) as usize;
+        let lower = unkey((key / 3) as usize, self.dims);
+        let mut upper = lower;
+        upper[axis] += 1;
+        let t = sample_crossing(self.sample(lower), self.sample(upper), self.iso);
+        core::array::from_fn(|d| lower[d] as f64 + if d == axis { t } else { 0.0 })
+    }
+
+    /// The triangles of the cube with key `cube`.
+    fn cube_range(&self, cube: u64) -> &[(u64, u32)] {
+        let lo = self.by_cube.partition_point(|&(k, _)| k < cube);
+        let hi = self.by_cube.partition_point(|&(k, _)| k <= cube);
+        &self.by_cube[lo..hi]
+    }
+
+    /// The Steps 1–3 triangles of the box of `side` at `corner`, in the metric's units.
+    fn patch(
+        &self,
+        corner: [usize; 3],
+        side: usize,
+        metric: &Metric,
+        out: &mut Vec<[[f64; 3]; 3]>,
+    ) {
+        out.clear();
+        for dz in 0..side {
+            for dy in 0..side {
+                for dx in 0..side {
+                    let cube = [corner[0] + dx, corner[1] + dy, corner[2] + dz];
+                    self.cube_triangles(cube, &mut |t| out.push(t.map(|p| scaled(p, metric))));
+                }
+            }
+        }
+    }
+
+    /// Decides the boxes of every size up to `2^levels`, smallest first: a box is tested only if
+    /// its eight children may all be boxes.
+    fn decide(&self, levels: usize, metric: &Metric) -> Lattice {
+        let mut lattice: Lattice = Vec::new();
+        let mut patch = Vec::new();
+        for level in 1..=levels {
+            let side = 1 << level;
+            let cells = self.dims.map(|d| (d - 1) / side);
+            if cells.contains(&0) {
+                break;
+            }
+            let mut states = vec![Cell::Cubes; cells.iter().product()];
+            for (i, state) in states.iter_mut().enumerate() {
+                let cell = unkey(i, cells);
+                if let Some((below, children)) = lattice.last() {
+                    let whole = (0..8).all(|k| {
+                        let child: [usize; 3] =
+                            core::array::from_fn(|d| 2 * cell[d] + (k >> d & 1));
+                        children[cell_index(child, *below)] != Cell::Cubes
+                    });
+                    if !whole {
+                        continue;
+                    }
+                }
+                let corner = cell.map(|c| c * side);
+                *state = match outline(self, corner, side) {
+                    Shape::Empty => Cell::Empty,
+                    Shape::Complex => Cell::Cubes,
+                    Shape::Simple(o) => {
+                        let may_chord = (0..o.n).fold(0u8, |m, i| {
+                            match neighbour(cell, usize::from(o.arc_face[i]), cells) {
+                                Some(_) => m | 1 << i,
+                                None => m,
+                            }
+                        });
+                        self.patch(corner, side, metric, &mut patch);
+                        if accept(self, &o, may_chord, &patch, metric) {
+                            Cell::Box
+                        } else {
+                            Cell::Cubes
+                        }
+                    }
+                };
+            }
+            lattice.push((cells, states));
+        }
+        lattice
+    }
+
+    /// The triangles: those of unit cubes outside boxes, in sweep order, then each box's, size
+    /// by size, in the variant its neighbours give it. `level` is the balanced size of the box
+    /// holding each pair of cubes (`final_levels`).
+    fn emit(&self, lattice: &Lattice, level: &[u8], metric: &Metric) -> Vec<[u32; 3]> {
+        let pairs = lattice[0].0;
+        let in_box = |cube_key: u64| -> bool {
+            let pair = unkey(cube_key as usize, self.dims).map(|c| c / 2);
+            (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
+        };
+        let mut out: Vec<[u32; 3]> = self
+            .triangles
+            .iter()
+            .zip(self.cubes)
+            .filter(|&(_, &c)| c == u64::MAX || !in_box(c))
+            .map(|(&t, _)| t)
+            .collect();
+        let mut patch = Vec::new();
+        for (l, (cells, states)) in lattice.iter().enumerate() {
+            let (l, side) = (l as u8 + 1, 2usize << l);
+            for (i, &state) in states.iter().enumerate() {
+                let cell = unkey(i, *cells);
+                let first = cell.map(|c| c * (side / 2));
+                if state != Cell::Box || level[cell_index(first, pairs)] != l {
+                    continue;
+                }
+                let corner = cell.map(|c| c * side);
+                let Shape::Simple(o) = outline(self, corner, side) else {
+                    continue;
+                };
+                // A face keeps its midline vertices unless a box at least as large is across.
+                let refined = (0..o.n).fold(0u8, |m, i| {
+                    let face = usize::from(o.arc_face[i]);
+                    match across(first, side / 2, face, pairs) {
+                        Some(j) if level[j] >= l => m,
+                        _ => m | 1 << i,
+                    }
+                });
+                self.patch(corner, side, metric, &mut patch);
+                // Accepted boxes triangulate in every variant (`accept`), and the choice
+                // depends on the box and its variant alone.
+                let Some(t) = triangulate(self, &o, refined, &patch, metric) else {
+                    debug_assert!(false, "an accepted box failed its variant");
+                    continue;
+                };
+                for tri in t.triangles() {
+                    let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
+                    if let [Some(a), Some(b), Some(c)] = ids {
+                        out.push([a, b, c]);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Per pair of cubes (the boxes of side 2), the level of the largest box holding it that may be
+/// one (0: none, its cubes stay).
+fn final_levels(lattice: &Lattice) -> Vec<u8> {
+    let pairs = lattice[0].0;
+    let mut level = vec![0u8; pairs.iter().product()];
+    for (l, (cells, states)) in lattice.iter().enumerate() {
+        let span = 1usize << l;
+        for (i, &state) in states.iter().enumerate() {
+            if state == Cell::Cubes {
+                continue;
+            }
+            let cell = unkey(i, *cells);
+            for k in 0..span * span * span {
+                let pair: [usize; 3] =
+                    core::array::from_fn(|d| cell[d] * span + k / span.pow(d as u32) % span);
+                level[cell_index(pair, pairs)] = l as u8 + 1;
+            }
+        }
+    }
+    level
+}
+
+/// Splits boxes until no box has a face neighbour less than half its side (the unique minimal
+/// 2:1 refinement). Every child of a box was accepted before it, in every variant, so a split
+/// never leaves an untested box. Cubes past the last pair of a volume with an odd number of
+/// cubes along an axis are unit cubes.
+fn balance(level: &mut [u8], pairs: [usize; 3], dims: [usize; 3]) {
+    loop {
+        let mut changed = false;
+        for i in 0..level.len() {
+            let l = level[i];
+            let first = unkey(i, pairs);
+            let span = 1usize << l.saturating_sub(1);
+            if l < 2 || first.iter().any(|&c| c % span != 0) {
+                continue;
+            }
+            let too_small = (0..6).any(|face| {
+                let (axis, high) = (face / 2, face % 2 == 1);
+                let at = if high {
+                    first[axis] + span
+                } else if first[axis] == 0 {
+                    return false;
+                } else {
+                    first[axis] - 1
+                };
+                if at >= pairs[axis] {
+                    // Unit cubes past the last pair, if the grid has any.
+                    return 2 * pairs[axis] < dims[axis] - 1;
+                }
+                let [a, b] = [(axis + 1) % 3, (axis + 2) % 3];
+                (0..span * span).any(|k| {
+                    let mut p = first;
+                    p[axis] = at;
+                    p[a] += k % span;
+                    p[b] += k / span;
+                    level[cell_index(p, pairs)] + 1 < l
+                })
+            });
+            if too_small {
+                for k in 0..span * span * span {
+                    let pair: [usize; 3] =
+                        core::array::from_fn(|d| first[d] + k / span.pow(d as u32) % span);
+                    level[cell_index(pair, pairs)] = l - 1;
+                }
+                changed = true;
+            }
+        }
+        if !changed {
+            return;
+        }
+    }
+}
+
+/// The pair of cubes across face `face` (`2 · axis + side`) of the box whose first pair is
+/// `first` and which spans `span` pairs, if that pair exists.
+fn across(first: [usize; 3], span: usize, face: usize, pairs: [usize; 3]) -> Option<usize> {
+    let (axis, high) = (face / 2, face % 2 == 1);
+    let mut p = first;
+    if high {
+        p[axis] += span;
+        if p[axis] >= pairs[axis] {
+            return None;
+        }
+    } else {
+        p[axis] = p[axis].checked_sub(1)?;
+    }
+    Some(cell_index(p, pairs))
+}
+
+/// The point of a grid of `dims` with index `i`, x fastest.
+fn unkey(i: usize, dims: [usize; 3]) -> [usize; 3] {
+    [i % dims[0], i / dims[0] % dims[1], i / (dims[0] * dims[1])]
+}
+
+impl<T: Scalar> BoxSource for Grid<'_, T> {
+    fn crossing(&self, lower: [usize; 3], axis: usize) -> Option<Crossing> {
+        let mut upper = lower;
+        upper[axis] += 1;
+        let (a, b) = (self.sample(lower), self.sample(upper));
+        let (fa, fb) = (a.filled(self.threshold), b.filled(self.threshold));
+        (fa != fb).then(|| Crossing {
+            t: sample_crossing(a, b, self.iso),
+            lower_filled: fa,
+        })
+    }
+
+    fn cube_triangles(&self, cube: [usize; 3], f: &mut dyn FnMut([[f64; 3]; 3])) {
+        for &(_, i) in self.cube_range(self.key(cube)) {
+            let t = self.triangles[i as usize];
+            f(t.map(|v| self.place(self.edges[v as usize])));
+        }
+    }
+}
+
+fn cell_index(cell: [usize; 3], cells: [usize; 3]) -> usize {
+    cell[0] + cells[0] * (cell[1] + cells[1] * cell[2])
+}
+
+/// The lattice box across face `face` (`2 · axis + side`) of `cell`, if there is one.
+fn neighbour(cell: [usize; 3], face: usize, cells: [usize; 3]) -> Option<usize> {
+    let (axis, side) = (face / 2, face % 2);
+    let mut n = cell;
+    if side == 0 {
+        n[axis] = n[axis].checked_sub(1)?;
+    } else {
+        n[axis] += 1;
+        if n[axis] >= cells[axis] {
+            return None;
+        }
+    }
+    Some(cell_index(n, cells))
+}
+
+/// Drops the vertices no triangle uses, keeping the others' order.
+fn compact(mesh: &mut Mesh) {
+    let n = mesh.positions.len();
+    let mut new_id = vec![u32::MAX; n];
+    for t in &mesh.triangles {
+        for &v in t {
+            new_id[v as usize] = 0;
+        }
+    }
+    let mut next = 0u32;
+    for id in new_id.iter_mut() {
+        if *id == 0 {
+            *id = next;
+            next += 1;
+        }
+    }
+    keep_column(&mut mesh.positions, &new_id);
+    keep_column(&mut mesh.normals, &new_id);
+    keep_column(&mut mesh.values, &new_id);
+    for t in &mut mesh.triangles {
+        *t = t.map(|v| new_id[v as usize]);
+    }
+}
+
+/// Keeps the entries of a per-vertex column (empty when not asked for) whose vertex stays.
+fn keep_column<C>(column: &mut Vec<C>, new_id: &[u32]) {
+    if column.is_empty() {
+        return;
+    }
+    let mut i = 0;
+    column.retain(|_| {
+        i += 1;
+        new_id[i - 1] != u32::MAX
+    });
+}

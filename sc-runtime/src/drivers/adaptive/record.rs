@@ -1,0 +1,63 @@
+//! The Steps 1–3 mesh of a volume, with the grid edge of each vertex and the cube of each
+//! triangle: what adaptive mode keeps of it, and what its boxes read.
+
+use alloc::vec::Vec;
+
+use crate::{Mesh, Sink};
+
+/// A mesh being swept, and each vertex's edge key and each triangle's cube key
+/// (`x + nx · (y + ny · z)`; an edge's key is `3 ·` its lower end's key `+` its axis).
+pub(super) struct Recorded {
+    pub mesh: Mesh,
+    pub edges: Vec<u64>,
+    pub cubes: Vec<u64>,
+    pub dims: [usize; 3],
+}
+
+impl Recorded {
+    pub fn new(dims: [usize; 3]) -> Recorded {
+        Recorded {
+            mesh: Mesh::default(),
+            edges: Vec::new(),
+            cubes: Vec::new(),
+            dims,
+        }
+    }
+
+    pub fn point_key(&self, p: [usize; 3]) -> u64 {
+        (p[0] + self.dims[0] * (p[1] + self.dims[1] * p[2])) as u64
+    }
+}
+
+impl Sink for Recorded {
+    fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
+        // Every vertex of the sweep comes with its edge; one without would have no key.
+        self.edges.push(u64::MAX);
+        self.mesh.vertex(position, normal);
+    }
+
+    fn edge_vertex(
+        &mut self,
+        lower: [usize; 3],
+        axis: usize,
+        position: [f32; 3],
+        normal: Option<[f32; 3]>,
+    ) {
+        self.edges.push(3 * self.point_key(lower) + axis as u64);
+        self.mesh.vertex(position, normal);
+    }
+
+    fn vertex_value(&mut self, value: f32) {
+        self.mesh.vertex_value(value);
+    }
+
+    fn triangle(&mut self, triangle: [u32; 3]) {
+        self.cubes.push(u64::MAX);
+        self.mesh.triangle(triangle);
+    }
+
+    fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {
+        self.cubes.push(self.point_key(cube));
+        self.mesh.triangle(triangle);
+    }
+}

@@ -1,0 +1,255 @@
+//! A box's triangles in one variant (docs/adaptive.md §3).
+//!
+//! A face of the box keeps its arc's midline vertices unless a box at least as large is across
+//! it (the smaller boxes or unit cubes across have those vertices on their edges); bit `i` of
+//! `refined` says so for arc `i`. The corner polygon (3 to 6 vertices) is triangulated in each of its 1,
+//! 2, 5 or 14 ways; in each, a coarse triangle whose sides include kept midline vertices becomes
+//! a small polygon, fanned from the one of its vertices that gives the best-shaped triangles
+//! with none lying in a face. Of the candidates that pass (F), (P) and (E), the one whose worst
+//! triangle is best shaped is taken, the first in enumeration order on a tie, so the choice is a
+//! function of the box's samples and its variant alone: the variant tested when the box was
+//! accepted is the one emitted.
+
+use super::checks::{faces_up, in_wall, quality, separates, simple_projection, within_bound};
+use super::outline::Outline;
+use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Metric, Vertex};
+
+/// A box's triangles, wound filled → empty.
+#[derive(Clone, Debug)]
+pub(crate) struct Triangulation {
+    tris: [[Vertex; 3]; MAX_TRIANGLES],
+    n: usize,
+}
+
+impl Triangulation {
+    /// The triangles.
+    pub fn triangles(&self) -> &[[Vertex; 3]] {
+        &self.tris[..self.n]
+    }
+
+    fn push(&mut self, t: [Vertex; 3]) -> bool {
+        if self.n == MAX_TRIANGLES {
+            return false;
+        }
+        self.tris[self.n] = t;
+        self.n += 1;
+        true
+    }
+}
+
+/// Calls `f` with each triangulation of the convex polygon `0 .. n` (`3 ≤ n ≤ 6`), as triples
+/// in increasing order, which is the polygon's order: each triangle keeps the loop's turn.
+pub(crate) fn each_coarse(n: usize, f: &mut dyn FnMut(&[[u8; 3]])) {
+    type Pending = [(u8, u8); MAX_CORNERS];
+    type Tris = [[u8; 3]; MAX_CORNERS - 2];
+    fn go(pending: Pending, np: usize, tris: Tris, nt: usize, f: &mut dyn FnMut(&[[u8; 3]])) {
+        if np == 0 {
+            f(&tris[..nt]);
+            return;
+        }
+        let (l, r) = pending[np - 1];
+        if r - l < 2 {
+            go(pending, np - 1, tris, nt, f);
+            return;
+        }
+        for k in l + 1..r {
+            let (mut p, mut t) = (pending, tris);
+            t[nt] = [l, k, r];
+            p[np - 1] = (l, k);
+            p[np] = (k, r);
+            go(p, np + 1, t, nt + 1, f);
+        }
+    }
+    if (3..=MAX_CORNERS).contains(&n) {
+        let mut pending = [(0, 0); MAX_CORNERS];
+        pending[0] = (0, n as u8 - 1);
+        go(pending, 1, [[0; 3]; MAX_CORNERS - 2], 0, f);
+    }
+}
+
+/// The boundary of coarse triangle `tri` in a variant: its corners, with the kept midline
+/// vertices of the arcs among its sides.
+fn refined_boundary(
+    outline: &Outline,
+    refined: u8,
+    tri: [u8; 3],
+) -> ([Vertex; 3 + 3 * MAX_MIDS], usize) {
+    let mut out = [Vertex::default(); 3 + 3 * MAX_MIDS];
+    let mut m = 0;
+    for s in 0..3 {
+        let (x, y) = (usize::from(tri[s]), usize::from(tri[(s + 1) % 3]));
+        out[m] = outline.corners[x];
+        m += 1;
+        if (x + 1) % outline.n == y && refined >> x & 1 == 1 {
+            for &w in &outline.mids[x][..usize::from(outline.mid_count[x])] {
+                out[m] = w;
+                m += 1;
+            }
+        }
+    }
+    (out, m)
+}
+
+/// The best fan of a small polygon whose triangles all face up and none lies in a face, with
+/// its worst triangle's quality.
+fn best_fan(
+    outline: &Outline,
+    q: &[Vertex],
+) -> Option<([[Vertex; 3]; 1 + 3 * MAX_MIDS], usize, f64)> {
+    let m = q.len();
+    let mut best: Option<([[Vertex; 3]; 1 + 3 * MAX_MIDS], usize, f64)> = None;
+    let apexes = if m == 3 { 1 } else { m };
+    for apex in 0..apexes {
+        let mut fan = [[Vertex::default(); 3]; 1 + 3 * MAX_MIDS];
+        let mut worst = f64::INFINITY;
+        let mut ok = true;
+        for s in 0..m - 2 {
+            let t = [q[apex], q[(apex + 1 + s) % m], q[(apex + 2 + s) % m]];
+            if in_wall(&t) || !faces_up(&t, outline) {
+                ok = false;
+                break;
+            }
+            worst = worst.min(quality(&t));
+            fan[s] = t;
+        }
+        if ok && best.as_ref().is_none_or(|b| worst > b.2) {
+            best = Some((fan, m - 2, worst));
+        }
+    }
+    best
+}
+
+/// The refined triangles of coarse triangulation `coarse`, with its worst triangle's quality,
+/// if every small polygon has a fan that faces up with no triangle in a face.
+fn refine(outline: &Outline, refined: u8, coarse: &[[u8; 3]]) -> Option<(Triangulation, f64)> {
+    let mut out = Triangulation {
+        tris: [[Vertex::default(); 3]; MAX_TRIANGLES],
+        n: 0,
+    };
+    let mut worst = f64::INFINITY;
+    for &tri in coarse {
+        let (q, len) = refined_boundary(outline, refined, tri);
+        let (fan, count, w) = best_fan(outline, &q[..len])?;
+        worst = worst.min(w);
+        for &t in &fan[..count] {
+            if !out.push(t) {
+                return None;
+            }
+        }
+    }
+    Some((out, worst))
+}
+
+/// The most coarse triangulations of a corner polygon: 14, of a hexagon.
+const MAX_COARSE: usize = 14;
+
+/// The box's triangles in the variant `refined`, if some triangulation passes every test: of
+/// those that do, the one whose worst triangle is best shaped. Candidates are refined and
+/// ranked first, then tested best first, so (P) and (E), the costly tests, usually run once.
+/// `patch` is the box's Steps 1–3 triangles in the metric's units.
+pub(crate) fn triangulate(
+    src: &impl BoxSource,
+    outline: &Outline,
+    refined: u8,
+    patch: &[[[f64; 3]; 3]],
+    metric: &Metric,
+) -> Option<Triangulation> {
+    let (polygon, m) = outline.polygon(refined);
+    if !simple_projection(&polygon[..m], outline.axis) {
+        return None;
+    }
+    // (quality, enumeration index) of each candidate whose fans exist.
+    let mut ranked = [(0.0, 0u8); MAX_COARSE];
+    let (mut n, mut index) = (0, 0u8);
+    each_coarse(outline.n, &mut |coarse| {
+        if let Some((_, worst)) = refine(outline, refined, coarse) {
+            ranked[n] = (worst, index);
+            n += 1;
+        }
+        index += 1;
+    });
+    // Best shaped first; on a tie, the first enumerated (a stable sort, by hand: n ≤ 14).
+    let ranked = &mut ranked[..n];
+    for i in 1..ranked.len() {
+        let mut j = i;
+        while j > 0 && ranked[j].0 > ranked[j - 1].0 {
+            ranked.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+    for &(_, wanted) in ranked.iter() {
+        let mut found = None;
+        let mut index = 0u8;
+        each_coarse(outline.n, &mut |coarse| {
+            if index == wanted {
+                found = refine(outline, refined, coarse).map(|(t, _)| t);
+            }
+            index += 1;
+        });
+        let Some(t) = found else { continue };
+        if separates(src, outline, refined, t.triangles())
+            && within_bound(t.triangles(), patch, metric)
+        {
+            return Some(t);
+        }
+    }
+    None
+}
+
+/// Whether the box can be emitted in every variant its neighbours may give it: bit `i` of
+/// `may_chord` is set iff the neighbour across arc `i`'s face may be a box of this size.
+pub(crate) fn accept(
+    src: &impl BoxSource,
+    outline: &Outline,
+    may_chord: u8,
+    patch: &[[[f64; 3]; 3]],
+    metric: &Metric,
+) -> bool {
+    let with_mids = (0..outline.n)
+        .filter(|&i| outline.has_mids(i))
+        .fold(0u8, |m, i| m | 1 << i);
+    let free = may_chord & with_mids;
+    let mut chords = free;
+    loop {
+        if triangulate(src, outline, with_mids & !chords, patch, metric).is_none() {
+            return false;
+        }
+        if chords == 0 {
+            return true;
+        }
+        chords = (chords - 1) & free;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::each_coarse;
+    use alloc::vec::Vec;
+
+    /// The Catalan numbers, each triangulation a set of `n − 2` increasing triples covering
+    /// every polygon side once, and no two alike.
+    #[test]
+    fn coarse_triangulations_are_all_the_triangulations() {
+        for (n, count) in [(3, 1), (4, 2), (5, 5), (6, 14)] {
+            let mut seen: Vec<Vec<[u8; 3]>> = Vec::new();
+            each_coarse(n, &mut |t| {
+                assert_eq!(t.len(), n - 2);
+                assert!(t.iter().all(|x| x[0] < x[1] && x[1] < x[2]));
+                for i in 0..n as u8 {
+                    let j = (i + 1) % n as u8;
+                    let (a, b) = (i.min(j), i.max(j));
+                    let sides = t
+                        .iter()
+                        .filter(|x| [(x[0], x[1]), (x[1], x[2]), (x[0], x[2])].contains(&(a, b)))
+                        .count();
+                    assert_eq!(sides, 1, "side {a}-{b} of {t:?}");
+                }
+                let mut s = t.to_vec();
+                s.sort_unstable();
+                assert!(!seen.contains(&s));
+                seen.push(s);
+            });
+            assert_eq!(seen.len(), count, "n = {n}");
+        }
+    }
+}

@@ -1,0 +1,453 @@
+//! Adaptive mode (docs/adaptive.md) on padded volumes: built-in, real crops and random noise.
+//!
+//! Each mesh is checked against the Steps 1–3 mesh of the same volume:
+//! - a closed, consistently oriented 2-manifold, no self-intersections (exact predicates);
+//! - every vertex a Steps 1–3 vertex (same position and normal bits);
+//! - every point of each mesh within the error bound of the other: sampled on a lattice of each
+//!   triangle that differs, against every triangle of the other mesh;
+//! - no sample on the wrong side: the two meshes differ by closed surfaces (each box's new patch
+//!   against its old one), and a sample changes side iff its winding number about them is ±1.
+
+use std::collections::{HashMap, HashSet};
+
+use sc_runtime::labels::{LabelParams, extract_labels};
+use sc_runtime::{Error, ErrorBound, Mesh, Mode, Params, Volume, demo, extract, extract_par};
+use sc_tests::checks::{assert_closed_manifold, assert_no_self_intersections};
+use sc_tests::geometry::{point_triangle_distance, solid_angle};
+use sc_tests::volumes::{
+    self, Sample, Vol, brainsmall_crop, integer_noise, itk_t1_crop, stent_crop,
+};
+
+type P = [f64; 3];
+
+fn adaptive_params<T: Sample>(vol: &Vol<T>, bound: ErrorBound) -> Params {
+    Params {
+        max_error: Some(bound),
+        ..vol.params(Mode::Adaptive)
+    }
+}
+
+fn run<T: Sample>(vol: &Vol<T>, params: &Params) -> Mesh {
+    let volume = Volume::new(&vol.data, vol.dims).unwrap();
+    extract(&volume, params).expect("adaptive extraction succeeds")
+}
+
+/// A triangle's corners, as bits: equal triangles of the two meshes compare equal, whatever
+/// their vertex ids, from any starting corner.
+fn canonical(positions: &[[f32; 3]], t: [u32; 3]) -> [[u32; 3]; 3] {
+    let c = t.map(|i| positions[i as usize].map(f32::to_bits));
+    let r = (0..3).min_by_key(|&k| c[k]).unwrap();
+    [c[r], c[(r + 1) % 3], c[(r + 2) % 3]]
+}
+
+fn corners(positions: &[[f32; 3]], t: [u32; 3]) -> [P; 3] {
+    t.map(|i| positions[i as usize].map(f64::from))
+}
+
+/// Triangles of `mesh` bucketed by the cells of side `h` their boxes, grown by `reach`, touch.
+struct Buckets<'m> {
+    mesh: &'m Mesh,
+    h: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl<'m> Buckets<'m> {
+    fn new(mesh: &'m Mesh, h: f64, reach: f64) -> Self {
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (i, &t) in mesh.triangles.iter().enumerate() {
+            let c = corners(&mesh.positions, t);
+            let lo: [i64; 3] = std::array::from_fn(|d| {
+                ((c.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min) - reach) / h).floor() as i64
+            });
+            let hi: [i64; 3] = std::array::from_fn(|d| {
+                ((c.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max) + reach) / h).floor()
+                    as i64
+            });
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        cells.entry([x, y, z]).or_default().push(i as u32);
+                    }
+                }
+            }
+        }
+        Buckets { mesh, h, cells }
+    }
+
+    /// The distance from `p` to the mesh, if some triangle is within the reach.
+    fn distance(&self, p: P) -> f64 {
+        let cell = p.map(|c| (c / self.h).floor() as i64);
+        self.cells.get(&cell).map_or(f64::INFINITY, |ts| {
+            ts.iter()
+                .map(|&i| {
+                    point_triangle_distance(
+                        p,
+                        corners(&self.mesh.positions, self.mesh.triangles[i as usize]),
+                    )
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+    }
+}
+
+/// The largest distance from a lattice of `n` steps per side on each triangle of `from` that is
+/// not in `to` (those in both are at distance 0) to the mesh `to`.
+fn one_way(from: &Mesh, to: &Mesh, reach: f64, n: usize) -> f64 {
+    let shared: HashSet<[[u32; 3]; 3]> = to
+        .triangles
+        .iter()
+        .map(|&t| canonical(&to.positions, t))
+        .collect();
+    let buckets = Buckets::new(to, 4.0 * reach.max(0.25), reach);
+    let mut worst: f64 = 0.0;
+    for &t in &from.triangles {
+        if shared.contains(&canonical(&from.positions, t)) {
+            continue;
+        }
+        let [a, b, c] = corners(&from.positions, t);
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (s, r) = (i as f64 / n as f64, j as f64 / n as f64);
+                let p: P = std::array::from_fn(|d| a[d] + s * (b[d] - a[d]) + r * (c[d] - a[d]));
+                worst = worst.max(buckets.distance(p));
+            }
+        }
+    }
+    worst
+}
+
+/// Samples on the wrong side of `mesh`, given that `reference` (Steps 1–3) separates them all:
+/// the triangles in one mesh and not the other form closed surfaces, one per connected piece,
+/// and a sample inside one of them (winding number ±1) has changed side.
+fn wrong_side<T: Sample>(vol: &Vol<T>, mesh: &Mesh, reference: &Mesh) -> usize {
+    let mut count: HashMap<[[u32; 3]; 3], i32> = HashMap::new();
+    for &t in &mesh.triangles {
+        *count.entry(canonical(&mesh.positions, t)).or_default() += 1;
+    }
+    let mut diff: Vec<[P; 3]> = Vec::new();
+    for &t in &reference.triangles {
+        let k = canonical(&reference.positions, t);
+        match count.get_mut(&k) {
+            Some(c) if *c > 0 => *c -= 1,
+            _ => {
+                let [a, b, c] = corners(&reference.positions, t);
+                diff.push([a, c, b]);
+            }
+        }
+    }
+    for &t in &mesh.triangles {
+        let k = canonical(&mesh.positions, t);
+        if let Some(c) = count.get_mut(&k)
+            && *c > 0
+        {
+            *c -= 1;
+            diff.push(corners(&mesh.positions, t));
+        }
+    }
+    // Connected pieces, by shared corners.
+    let key = |p: P| p.map(|c| (c as f32).to_bits());
+    let mut parent: Vec<usize> = (0..diff.len()).collect();
+    fn find(parent: &mut [usize], i: usize) -> usize {
+        let mut r = i;
+        while parent[r] != r {
+            r = parent[r];
+        }
+        parent[i] = r;
+        r
+    }
+    let mut first: HashMap<[u32; 3], usize> = HashMap::new();
+    for (i, t) in diff.iter().enumerate() {
+        for &p in t {
+            let j = *first.entry(key(p)).or_insert(i);
+            let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+            parent[a] = b;
+        }
+    }
+    let mut pieces: HashMap<usize, Vec<usize>> = HashMap::new();
+    for i in 0..diff.len() {
+        let r = find(&mut parent, i);
+        pieces.entry(r).or_default().push(i);
+    }
+    let mut wrong = 0;
+    for tris in pieces.values() {
+        let lo: P = std::array::from_fn(|d| {
+            tris.iter()
+                .flat_map(|&i| diff[i])
+                .map(|p| p[d])
+                .fold(f64::INFINITY, f64::min)
+        });
+        let hi: P = std::array::from_fn(|d| {
+            tris.iter()
+                .flat_map(|&i| diff[i])
+                .map(|p| p[d])
+                .fold(f64::NEG_INFINITY, f64::max)
+        });
+        let index = |w: f64, d: usize| (w - vol.origin[d]) / vol.spacing[d];
+        let (a, b): ([usize; 3], [usize; 3]) = (
+            std::array::from_fn(|d| index(lo[d], d).ceil().max(0.0) as usize),
+            std::array::from_fn(|d| (index(hi[d], d).floor() as usize).min(vol.dims[d] - 1)),
+        );
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    let p = vol.world([x, y, z]);
+                    let w: f64 = tris.iter().map(|&i| solid_angle(p, diff[i])).sum::<f64>()
+                        / (4.0 * std::f64::consts::PI);
+                    if w.abs() > 0.5 {
+                        wrong += 1;
+                    }
+                }
+            }
+        }
+    }
+    wrong
+}
+
+/// Every check on one padded volume at one bound (in grid steps); returns the triangle counts
+/// (Steps 1–3, adaptive).
+fn holds<T: Sample>(vol: &Vol<T>, bound: f64, what: &str) -> (usize, usize) {
+    let steps123 = vol.extract(Mode::Steps123);
+    let params = adaptive_params(vol, ErrorBound::Voxels(bound));
+    let mesh = run(vol, &params);
+    let what = format!("{what} at {bound} voxel");
+    assert_eq!(mesh.stats.t13, steps123.triangles.len() as u64, "{what}");
+    assert_eq!(mesh.stats.triangles, mesh.triangles.len() as u64, "{what}");
+    assert_eq!(mesh.stats.vertices, mesh.positions.len() as u64, "{what}");
+    assert_closed_manifold(&mesh, &what);
+    assert_no_self_intersections(&mesh, &what);
+    // Every vertex is a Steps 1–3 vertex, with its normal.
+    let old: HashMap<[u32; 3], [u32; 3]> = steps123
+        .positions
+        .iter()
+        .zip(&steps123.normals)
+        .map(|(p, n)| (p.map(f32::to_bits), n.map(f32::to_bits)))
+        .collect();
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        assert_eq!(
+            old.get(&p.map(f32::to_bits)),
+            Some(&n.map(f32::to_bits)),
+            "{what}: {p:?}"
+        );
+    }
+    assert_eq!(mesh.normals.len(), mesh.positions.len());
+    // The bound, both ways, in grid steps (unit spacing on the volumes here, or scaled).
+    let least = vol.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+    let bound_world = bound * least;
+    assert!(
+        vol.spacing.iter().all(|&s| s == least),
+        "{what}: isotropic volumes only"
+    );
+    let tol = 1e-4 * least;
+    let there = one_way(&mesh, &steps123, bound_world, 6);
+    let back = one_way(&steps123, &mesh, bound_world, 6);
+    assert!(
+        there <= bound_world + tol,
+        "{what}: adaptive → Steps 1–3 {there}"
+    );
+    assert!(
+        back <= bound_world + tol,
+        "{what}: Steps 1–3 → adaptive {back}"
+    );
+    let wrong = wrong_side(vol, &mesh, &steps123);
+    println!(
+        "{what}: Steps 1–3 {} triangles, adaptive {} ({:.2}×), {} vertices of {}; distance {:.3} / {:.3} voxel; {wrong} samples on the wrong side",
+        steps123.triangles.len(),
+        mesh.triangles.len(),
+        steps123.triangles.len() as f64 / mesh.triangles.len().max(1) as f64,
+        mesh.positions.len(),
+        steps123.positions.len(),
+        there / least,
+        back / least,
+    );
+    assert_eq!(wrong, 0, "{what}");
+    (steps123.triangles.len(), mesh.triangles.len())
+}
+
+#[test]
+fn demo_volumes_hold_every_check() {
+    for (v, what) in [
+        (demo::knot(64), "knot 64³"),
+        (demo::torus(48), "torus 48³"),
+        (demo::sphere_noise(40), "sphere 40³"),
+    ] {
+        let vol = volumes::demo(v);
+        let mut last = usize::MAX;
+        for bound in [0.0, 0.25, 0.5, 1.0] {
+            let (s123, ours) = holds(&vol, bound, what);
+            if bound == 0.0 {
+                assert_eq!(ours, s123, "{what}: a zero bound keeps Steps 1–3");
+            } else {
+                assert!(ours < s123, "{what}: boxes at {bound} save triangles");
+            }
+            assert!(ours <= last, "{what}: a looser bound never adds triangles");
+            last = ours;
+        }
+    }
+}
+
+#[test]
+fn real_crops_hold_every_check() {
+    let b = brainsmall_crop().padded(0);
+    let s = stent_crop(281.0).padded(-2000);
+    for bound in [0.5, 1.0] {
+        holds(&b, bound, "brainsmall crop");
+        holds(&s, bound, "stent crop");
+    }
+}
+
+#[test]
+fn random_noise_holds_every_check() {
+    for seed in 0..12 {
+        let vol = integer_noise([9, 8, 7], 4, seed);
+        let padded = vol.padded(0);
+        for iso in [1.0, 1.5, 2.0, 3.0] {
+            let v = Vol {
+                iso,
+                ..padded.clone()
+            };
+            holds(&v, 0.75, &format!("noise seed {seed} iso {iso}"));
+        }
+    }
+}
+
+/// Smooth noise: values from a few random waves, where boxes are common and varied.
+#[test]
+fn smooth_noise_holds_every_check() {
+    for seed in 0..6u64 {
+        let r = |k: u64| (volumes::splitmix(seed * 16 + k) % 1000) as f64 / 1000.0;
+        let (a, b, c, d) = (
+            r(0) * 0.6 + 0.2,
+            r(1) * 0.6 + 0.2,
+            r(2) * 0.6 + 0.2,
+            r(3) * 6.0,
+        );
+        let vol = volumes::sampled([18, 17, 16], 0.0, |x, y, z| {
+            (a * x + d).sin() + (b * y).cos() + (c * z + a * y).sin() - 0.3
+        });
+        let padded = vol.padded(-10.0);
+        holds(&padded, 0.5, &format!("waves seed {seed}"));
+    }
+}
+
+/// The anisotropic crop in world units: closed, embedded, vertices from Steps 1–3, and the one
+/// thread and the threaded entry point give the same mesh.
+#[test]
+fn anisotropic_crop_and_entry_points() {
+    let vol = itk_t1_crop().padded(0);
+    let params = adaptive_params(&vol, ErrorBound::World(1.0));
+    let mesh = run(&vol, &params);
+    assert_closed_manifold(&mesh, "itk crop");
+    assert_no_self_intersections(&mesh, "itk crop");
+    let steps123 = vol.extract(Mode::Steps123);
+    assert!(mesh.triangles.len() < steps123.triangles.len());
+    let volume = Volume::new(&vol.data, vol.dims).unwrap();
+    assert_eq!(extract_par(&volume, &params, 2, &|_| {}).unwrap(), mesh);
+    // No bound given: half the smallest spacing.
+    let default = run(&vol, &vol.params(Mode::Adaptive));
+    let half = run(&vol, &adaptive_params(&vol, ErrorBound::World(1.0)));
+    assert_eq!(default, half);
+}
+
+#[test]
+fn bad_options_are_refused() {
+    let vol = volumes::demo(demo::torus(16));
+    let volume = Volume::new(&vol.data, vol.dims).unwrap();
+    let base = vol.params(Mode::Adaptive);
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let p = Params {
+            max_error: Some(ErrorBound::Voxels(bad)),
+            ..base
+        };
+        assert_eq!(extract(&volume, &p), Err(Error::MaxError), "{bad}");
+    }
+    // 15 cubes along each axis: boxes up to 8.
+    for (given, ok) in [
+        (0, false),
+        (1, true),
+        (2, true),
+        (3, false),
+        (8, true),
+        (12, false),
+        (16, false),
+    ] {
+        let p = Params {
+            max_box: Some(given),
+            ..base
+        };
+        let got = extract(&volume, &p);
+        assert_eq!(got.is_ok(), ok, "max_box {given}");
+        if !ok {
+            assert_eq!(got, Err(Error::MaxBox { given, largest: 8 }));
+        }
+    }
+    // A box of one cube is Steps 1–3.
+    let one = extract(
+        &volume,
+        &Params {
+            max_box: Some(1),
+            ..base
+        },
+    )
+    .unwrap();
+    assert_eq!(one.triangles, vol.extract(Mode::Steps123).triangles);
+    // The box option needs adaptive mode; entry points without it refuse the mode.
+    let p = Params {
+        max_box: Some(2),
+        ..vol.params(Mode::Embedded)
+    };
+    assert!(matches!(
+        extract(&volume, &p),
+        Err(Error::NotAdaptive { .. })
+    ));
+    let labels = [0u8, 1, 1, 0, 0, 1, 1, 0];
+    let label_params = LabelParams {
+        mode: Mode::Adaptive,
+        ..LabelParams::default()
+    };
+    assert!(matches!(
+        extract_labels(Volume::new(&labels, [2, 2, 2]).unwrap(), &label_params),
+        Err(Error::NotAdaptive { .. })
+    ));
+    let cubes = [0..15, 0..15, 0..15];
+    assert!(matches!(
+        sc_runtime::extract_block(&volume, [0; 3], vol.dims, cubes, &base),
+        Err(Error::NotAdaptive { .. })
+    ));
+}
+
+/// Boxes larger than two cubes grow and are kept: on the torus, `max_box` 16 gives fewer
+/// triangles than 2, and some triangle side is longer than any in a box of two cubes (its
+/// diagonal, 2√3 grid steps). Every check of `holds` runs on this volume and bound above, with
+/// `max_box` 16.
+#[test]
+fn larger_boxes_grow() {
+    let vol = volumes::demo(demo::torus(48));
+    let params = |max_box| Params {
+        max_box: Some(max_box),
+        ..adaptive_params(&vol, ErrorBound::Voxels(1.0))
+    };
+    let longest = |m: &Mesh| -> f64 {
+        let grid = |i: u32| -> P {
+            let p = m.positions[i as usize];
+            std::array::from_fn(|d| (f64::from(p[d]) - vol.origin[d]) / vol.spacing[d])
+        };
+        m.triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(a, b)| {
+                let (a, b) = (grid(a), grid(b));
+                (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>().sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    let (small, large) = (run(&vol, &params(2)), run(&vol, &params(16)));
+    let diagonal = 2.0 * 3f64.sqrt();
+    assert!(longest(&small) <= diagonal + 1e-4, "{}", longest(&small));
+    assert!(longest(&large) > diagonal, "{}", longest(&large));
+    assert!(large.triangles.len() < small.triangles.len());
+    println!(
+        "torus 48³ at 1 voxel: max_box 2 {} triangles, 16 {}",
+        small.triangles.len(),
+        large.triangles.len()
+    );
+}
