@@ -226,7 +226,7 @@ pub struct ExtractArgs {
     /// mesh, neighbours sharing their interfaces exactly. `all` or a list such as `1,5,17-20`
     /// chooses which labels get a mesh.
     #[arg(long, value_name = "all|LIST", value_parser = sc_io::labels::Selection::parse,
-          conflicts_with_all = ["iso", "demo", "stream", "shards", "max_error", "pad"])]
+          conflicts_with_all = ["iso", "demo", "stream", "shards", "max_error", "max_box", "pad"])]
     pub labels: Option<sc_io::labels::Selection>,
     /// With --labels: the label of no region, not meshed, and what lies outside the volume.
     #[arg(long, requires = "labels", default_value_t = 0)]
@@ -270,6 +270,9 @@ pub struct ExtractArgs {
     /// ways (default: half the smallest spacing).
     #[arg(long, value_parser = parse_max_error)]
     pub max_error: Option<f64>,
+    /// With --mode adaptive: the largest box, in cubes per side (1, 2, 4, 8 or 16; default 16).
+    #[arg(long, value_parser = parse_max_box)]
+    pub max_box: Option<u32>,
     /// The units of `--max-error`.
     #[arg(
         long,
@@ -451,6 +454,13 @@ impl Output {
         let format = MeshFormat::from_path(&path)?;
         Ok(Output { path, format })
     }
+}
+
+fn parse_max_box(s: &str) -> Result<u32, String> {
+    s.parse::<u32>()
+        .ok()
+        .filter(|b| b.is_power_of_two() && *b <= 16)
+        .ok_or_else(|| format!("{s:?}: give a box side in cubes: 1, 2, 4, 8 or 16"))
 }
 
 fn parse_smoothing(s: &str) -> Result<f64, String> {

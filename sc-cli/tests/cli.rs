@@ -570,3 +570,58 @@ fn max_error_trades_triangles_for_a_bound() {
     }
     assert!(!dir.path().join("bad.ply").exists());
 }
+
+/// `--max-box` caps adaptive mode's boxes: more triangles with smaller boxes, never more than
+/// Steps 1–3; refused outside adaptive mode and for a side that is not a power of two up to
+/// 16, before anything is written.
+#[test]
+fn max_box_caps_adaptive_boxes_and_is_refused_elsewhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let triangles = |args: &[&str]| {
+        let stats = dir.path().join("stats.json");
+        let out = dir.path().join("torus.ply");
+        let mut all = vec!["extract", "--demo", "torus", "--size", "40", "-q", "-o"];
+        all.push(out.to_str().unwrap());
+        all.extend_from_slice(&["--stats-json", stats.to_str().unwrap()]);
+        all.extend_from_slice(args);
+        let run = Command::cargo_bin("skelclimb")
+            .unwrap()
+            .args(&all)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(stats).unwrap()).unwrap();
+        json["result"]["triangles"].as_u64().unwrap()
+    };
+    let steps123 = triangles(&["--mode", "steps123"]);
+    let small = triangles(&["--mode", "adaptive", "--max-box", "2"]);
+    let large = triangles(&["--mode", "adaptive", "--max-box", "16"]);
+    assert!(
+        large <= small && small < steps123,
+        "{large} {small} {steps123}"
+    );
+    for (args, says) in [
+        (vec!["--max-box", "4"], "--mode adaptive"),
+        (vec!["--mode", "adaptive", "--max-box", "3"], "--max-box"),
+        (vec!["--mode", "adaptive", "--max-box", "32"], "--max-box"),
+    ] {
+        let out = dir.path().join("refused.ply");
+        let run = Command::cargo_bin("skelclimb")
+            .unwrap()
+            .args(["extract", "--demo", "torus", "-o", out.to_str().unwrap()])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(run.status.code(), Some(2), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&run.stderr).contains(says),
+            "{args:?}"
+        );
+        assert!(!out.exists(), "{args:?}");
+    }
+}

@@ -30,6 +30,8 @@ pub struct Request {
     pub coordinates: Coordinates,
     /// The bound on Step 4's displacement of the surface, if any.
     pub max_error: Option<ErrorBound>,
+    /// Adaptive mode's largest box, in cubes per side (its default if `None`).
+    pub max_box: Option<u32>,
 }
 
 impl Request {
@@ -42,6 +44,7 @@ impl Request {
             threads: 0,
             coordinates: Coordinates::Native,
             max_error: None,
+            max_box: None,
         }
     }
 }
@@ -54,6 +57,7 @@ fn params(grid: &Grid, request: &Request, world: &World) -> Params {
     params.normals = request.normals;
     params.spacing = grid.spacing;
     params.max_error = request.max_error;
+    params.max_box = request.max_box;
     if world.is_translation() {
         params.origin = world.offset;
     }

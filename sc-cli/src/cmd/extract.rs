@@ -130,6 +130,11 @@ fn check_output(args: &ExtractArgs, output: &Output) -> Result<()> {
     if args.block.is_some() {
         return Err(Error::Usage("--block applies with --shards only".into()));
     }
+    if args.max_box.is_some() && args.mode != Mode::Adaptive {
+        return Err(Error::Usage(
+            "--max-box applies with --mode adaptive only".into(),
+        ));
+    }
     if args.ascii && output.format != MeshFormat::Ply {
         return Err(Error::Usage("--ascii applies to .ply output only".into()));
     }
@@ -333,6 +338,7 @@ fn request(args: &ExtractArgs, iso: f64) -> Request {
         threads: args.threads,
         coordinates: args.space,
         max_error: args.error_bound(),
+        max_box: args.max_box,
     }
 }
 
