@@ -6,19 +6,13 @@ use alloc::vec::Vec;
 
 use super::sweep::{Ear, Edge, Piece};
 use super::{Atlas, Label};
-use crate::Stats;
 
 /// The pieces, in order of their layers, as one atlas, with their ears, vertex edges and
 /// pinned vertices renumbered alike.
 pub(super) fn join<L: Label>(
     pieces: Vec<Piece<L>>,
 ) -> (Atlas<L>, Vec<Ear<L>>, Vec<Edge>, Vec<u32>) {
-    let mut atlas = Atlas {
-        positions: Vec::new(),
-        triangles: Vec::new(),
-        pairs: Vec::new(),
-        stats: Stats::default(),
-    };
+    let mut atlas = Atlas::default();
     let mut ears = Vec::new();
     let mut edges = Vec::new();
     let mut pinned = Vec::new();

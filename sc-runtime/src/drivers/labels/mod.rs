@@ -222,6 +222,18 @@ fn sweep_pieces<L: Label>(
         .collect()
 }
 
+/// An empty atlas, for any label type (a derived `Default` would ask `L: Default`).
+impl<L> Default for Atlas<L> {
+    fn default() -> Self {
+        Atlas {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            pairs: Vec::new(),
+            stats: Stats::default(),
+        }
+    }
+}
+
 impl<L: Label> Atlas<L> {
     /// The labels with a surface, ascending, without the background (`background`).
     pub fn labels(&self, background: L) -> Vec<L> {

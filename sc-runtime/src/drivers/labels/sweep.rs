@@ -10,7 +10,7 @@ use core::ops::Range;
 
 use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
 use crate::tables::NO_EAR;
-use crate::{Error, Mode, Stats, Volume};
+use crate::{Error, Mode, Volume};
 
 const NONE: u32 = u32::MAX;
 
@@ -295,12 +295,7 @@ pub(super) fn sweep<L: Label>(
     layers: Range<usize>,
 ) -> Result<Piece<L>, Error> {
     let [nx, ny, _] = grid.n;
-    let mut atlas = Atlas {
-        positions: Vec::new(),
-        triangles: Vec::new(),
-        pairs: Vec::new(),
-        stats: Stats::default(),
-    };
+    let mut atlas = Atlas::default();
     let mut ears = Vec::new();
     let mut ids = Ids::new(nx, ny);
     let pad = f64::from(u8::from(params.pad));

@@ -284,22 +284,7 @@ impl Surface {
                         if l[i] == w || l[(i + 3) % 4] == l[i] {
                             continue;
                         }
-                        let mut run = Piece {
-                            corner: face[i],
-                            ..Piece::default()
-                        };
-                        run.push(node(i + 3));
-                        let mut j = i;
-                        loop {
-                            run.push(face[j % 4]);
-                            s.union(f, i, j % 4);
-                            if l[(j + 1) % 4] != l[i] {
-                                break;
-                            }
-                            j += 1;
-                        }
-                        run.push(node(j));
-                        s.add_piece(run);
+                        let j = s.add_run(f, &l, i, &[node(i + 3)]);
                         s.add_side(Side {
                             nodes: [node(i + 3) - 8, node(j) - 8],
                             from: face[i],
@@ -324,23 +309,7 @@ impl Surface {
                         if l[(i + 3) % 4] == l[i] {
                             continue;
                         }
-                        let mut run = Piece {
-                            corner: face[i],
-                            ..Piece::default()
-                        };
-                        run.push(centre);
-                        run.push(node(i + 3));
-                        let mut j = i;
-                        loop {
-                            run.push(face[j % 4]);
-                            s.union(f, i, j % 4);
-                            if l[(j + 1) % 4] != l[i] {
-                                break;
-                            }
-                            j += 1;
-                        }
-                        run.push(node(j));
-                        s.add_piece(run);
+                        s.add_run(f, &l, i, &[centre, node(i + 3)]);
                     }
                 }
             }
@@ -363,6 +332,37 @@ impl Surface {
     fn add_side(&mut self, side: Side) {
         self.sides[self.n_sides] = side;
         self.n_sides += 1;
+    }
+
+    /// Adds the piece of face `f` (labels `l`) held by the run of corners from position `i`:
+    /// `lead`, the run's corners, then the node after it. Returns the run's last position.
+    fn add_run<K: PartialEq + Copy>(
+        &mut self,
+        f: usize,
+        l: &[K; 4],
+        i: usize,
+        lead: &[u8],
+    ) -> usize {
+        let face = FACES[f];
+        let mut run = Piece {
+            corner: face[i],
+            ..Piece::default()
+        };
+        for &entry in lead {
+            run.push(entry);
+        }
+        let mut j = i;
+        loop {
+            run.push(face[j % 4]);
+            self.union(f, i, j % 4);
+            if l[(j + 1) % 4] != l[i] {
+                break;
+            }
+            j += 1;
+        }
+        run.push(8 + corner_edge(face[j % 4], face[(j + 1) % 4]));
+        self.add_piece(run);
+        j
     }
 
     fn add_piece(&mut self, piece: Piece) {
