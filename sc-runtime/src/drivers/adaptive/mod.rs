@@ -18,10 +18,10 @@ use alloc::vec::Vec;
 use crate::drivers::borrowed::sweep_into;
 use crate::drivers::has_cubes;
 use crate::kernel::Binary;
-use crate::kernel::adaptive::checks::scaled;
+use crate::kernel::adaptive::checks::{Memo, scaled};
 use crate::kernel::adaptive::outline::Shape;
 use crate::kernel::adaptive::{
-    BoxSource, Crossing, Tolerance, Vertex, accept, outline, triangulate,
+    BoxSource, Crossing, Patch, Tolerance, Vertex, accept, outline, triangulate,
 };
 use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
@@ -58,6 +58,13 @@ pub(crate) fn check(params: &Params, dims: [usize; 3]) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// The storage behind a box's [`Patch`], reused from box to box.
+#[derive(Default)]
+struct PatchBuf {
+    tris: Vec<[[f64; 3]; 3]>,
+    starts: Vec<u32>,
 }
 
 /// Extracts the adaptive mesh of `volume` (see the module's steps).
@@ -209,22 +216,35 @@ impl<'a, T: Scalar> Grid<'a, T> {
         &self.by_cube[lo..hi]
     }
 
-    /// The Steps 1–3 triangles of the box of `side` at `corner`, in the tolerance's units.
-    fn patch(
+    /// The Steps 1–3 triangles of the box of `side` at `corner`, in the tolerance's units, cube by
+    /// cube into `buf`.
+    fn patch<'b>(
         &self,
         corner: [usize; 3],
         side: usize,
         tolerance: &Tolerance,
-        out: &mut Vec<[[f64; 3]; 3]>,
-    ) {
-        out.clear();
+        buf: &'b mut PatchBuf,
+    ) -> Patch<'b> {
+        buf.tris.clear();
+        buf.starts.clear();
         for dz in 0..side {
             for dy in 0..side {
                 for dx in 0..side {
+                    buf.starts.push(buf.tris.len() as u32);
                     let cube = [corner[0] + dx, corner[1] + dy, corner[2] + dz];
-                    self.cube_triangles(cube, &mut |t| out.push(t.map(|p| scaled(p, tolerance))));
+                    self.cube_triangles(cube, &mut |t| {
+                        buf.tris.push(t.map(|p| scaled(p, tolerance)))
+                    });
                 }
             }
+        }
+        buf.starts.push(buf.tris.len() as u32);
+        Patch {
+            tris: &buf.tris,
+            starts: &buf.starts,
+            corner,
+            side,
+            scale: tolerance.scale,
         }
     }
 
@@ -232,7 +252,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
     /// its eight children may all be boxes.
     fn decide(&self, levels: usize, tolerance: &Tolerance) -> Lattice {
         let mut lattice: Lattice = Vec::new();
-        let mut patch = Vec::new();
+        let mut buf = PatchBuf::default();
         for level in 1..=levels {
             let side = 1 << level;
             let cells = self.dims.map(|d| (d - 1) / side);
@@ -263,7 +283,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
                                 None => m,
                             }
                         });
-                        self.patch(corner, side, tolerance, &mut patch);
+                        let patch = self.patch(corner, side, tolerance, &mut buf);
                         if accept(self, &o, may_chord, &patch, tolerance) {
                             Cell::Box
                         } else {
@@ -293,7 +313,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
             .filter(|&(_, &c)| c == u64::MAX || !in_box(c))
             .map(|(&t, _)| t)
             .collect();
-        let mut patch = Vec::new();
+        let mut buf = PatchBuf::default();
         for (l, (cells, states)) in lattice.iter().enumerate() {
             let (l, side) = (l as u8 + 1, 2usize << l);
             for (i, &state) in states.iter().enumerate() {
@@ -314,10 +334,11 @@ impl<'a, T: Scalar> Grid<'a, T> {
                         _ => m | 1 << i,
                     }
                 });
-                self.patch(corner, side, tolerance, &mut patch);
+                let patch = self.patch(corner, side, tolerance, &mut buf);
                 // Accepted boxes triangulate in every variant (`accept`), and the choice
                 // depends on the box and its variant alone.
-                let Some(t) = triangulate(self, &o, refined, &patch, tolerance) else {
+                let Some(t) = triangulate(self, &o, refined, &patch, tolerance, &mut Memo::new())
+                else {
                     debug_assert!(false, "an accepted box failed its variant");
                     continue;
                 };

@@ -6,7 +6,7 @@
 //! costs triangles.
 
 use super::outline::{Outline, on_line, others};
-use super::{BoxSource, MAX_POLYGON, Tolerance, Vertex};
+use super::{BoxSource, MAX_POLYGON, Patch, Tolerance, Vertex};
 use crate::geometry::point_triangle_distance_squared;
 use crate::kernel::vertex::root::sqrt;
 
@@ -326,63 +326,182 @@ pub(crate) fn scaled(p: [f64; 3], tolerance: &Tolerance) -> [f64; 3] {
     core::array::from_fn(|d| p[d] * tolerance.scale[d])
 }
 
-/// (E): the box's triangles and the Steps 1–3 triangles of the box (`patch`, in the tolerance's
-/// units) lie within the bound of each other, every point of each (not only sampled ones): see
-/// [`within`].
+/// (E): the box's triangles and the Steps 1–3 triangles of the box lie within the bound of each
+/// other, every point of each (not only sampled ones): see [`within`]. Steps 1–3's triangles
+/// are small, and one of the box's usually covers each whole.
 pub(crate) fn within_bound(
     tris: &[[Vertex; 3]],
-    patch: &[[[f64; 3]; 3]],
+    patch: &Patch<'_>,
     tolerance: &Tolerance,
+    memo: &mut Memo,
 ) -> bool {
     let mut ours = [[[0.0; 3]; 3]; super::MAX_TRIANGLES];
     for (i, t) in tris.iter().enumerate() {
         ours[i] = t.map(|v| scaled(v.p, tolerance));
     }
     let ours = &ours[..tris.len()];
-    ours.iter().all(|&t| within(t, patch, tolerance.limit))
-        && patch.iter().all(|&t| within(t, ours, tolerance.limit))
+    ours.iter()
+        .all(|&t| memo.get_or(t, || within(t, patch, tolerance.limit)))
+        && patch.tris.iter().all(|&t| within(t, ours, tolerance.limit))
 }
 
+/// Which of a box's triangles lie within the bound of its patch, remembered while the box is
+/// judged: its variants and candidate triangulations share most triangles.
+#[derive(Clone, Debug)]
+pub(crate) struct Memo {
+    seen: [([[f64; 3]; 3], bool); Memo::SIZE],
+    n: usize,
+}
+
+impl Memo {
+    /// Triangles remembered; later ones are measured each time.
+    const SIZE: usize = 96;
+
+    /// Nothing remembered.
+    pub fn new() -> Self {
+        Memo {
+            seen: [([[0.0; 3]; 3], false); Memo::SIZE],
+            n: 0,
+        }
+    }
+
+    /// `t`'s answer, from memory or from `f`.
+    fn get_or(&mut self, t: [[f64; 3]; 3], f: impl FnOnce() -> bool) -> bool {
+        if let Some(&(_, ok)) = self.seen[..self.n].iter().find(|(s, _)| *s == t) {
+            return ok;
+        }
+        let ok = f();
+        if self.n < Memo::SIZE {
+            self.seen[self.n] = (t, ok);
+            self.n += 1;
+        }
+        ok
+    }
+}
+
+/// Triangles [`within`] measures against.
+pub(crate) trait Nearby {
+    /// All of them.
+    fn tris(&self) -> &[[[f64; 3]; 3]];
+    /// The first index, among the triangles that may meet the box `lo ..= hi`, for which `f`
+    /// holds.
+    fn find(&self, lo: [f64; 3], hi: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize>;
+}
+
+impl Nearby for [[[f64; 3]; 3]] {
+    fn tris(&self) -> &[[[f64; 3]; 3]] {
+        self
+    }
+
+    fn find(&self, _: [f64; 3], _: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize> {
+        (0..self.len()).position(f)
+    }
+}
+
+impl Nearby for Patch<'_> {
+    fn tris(&self) -> &[[[f64; 3]; 3]] {
+        self.tris
+    }
+
+    /// Only the cubes whose closed box meets `lo ..= hi`: a Steps 1–3 triangle lies in its cube.
+    fn find(&self, lo: [f64; 3], hi: [f64; 3], mut f: impl FnMut(usize) -> bool) -> Option<usize> {
+        let mut from = [0; 3];
+        let mut to = [0; 3];
+        for d in 0..3 {
+            let at = self.corner[d] as f64;
+            let first = (lo[d] / self.scale[d] - at).floor() - 1.0;
+            let last = ((hi[d] / self.scale[d] - at).floor()).min(self.side as f64 - 1.0);
+            if last < first.max(0.0) {
+                return None;
+            }
+            from[d] = first.max(0.0) as usize;
+            to[d] = last as usize;
+        }
+        for z in from[2]..=to[2] {
+            for y in from[1]..=to[1] {
+                for x in from[0]..=to[0] {
+                    let c = x + self.side * (y + self.side * z);
+                    let range = self.starts[c] as usize..self.starts[c + 1] as usize;
+                    if let Some(k) = range.into_iter().find(|&k| f(k)) {
+                        return Some(k);
+                    }
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Sub-triangles `within` may split a triangle into, by halving its sides, before it gives up:
+/// pieces of 1/1024 of the side, far below any bound worth asking.
+const MAX_DEPTH: usize = 10;
+
 /// Whether every point of triangle `t` lies within `limit` of one of `others`. The distance to
-/// a set is 1-Lipschitz, and every point of a triangle whose longest side is `l` lies within
-/// `l / √3` of one of its corners (the circumradius when it is acute, at most `l / 2`
-/// otherwise). So sampling `t` on a lattice of `n` steps per side and requiring each sample
-/// within `limit − l / (n√3)` bounds every point; `n` is chosen so that this slack is at most
-/// a quarter of the limit (half would halve the work but leave most boxes at half the bound).
-pub(crate) fn within(t: [[f64; 3]; 3], others: &[[[f64; 3]; 3]], limit: f64) -> bool {
-    if limit.is_nan() || limit <= 0.0 {
+/// one triangle is a convex function, so a piece of `t` whose three corners lie within `limit`
+/// of the same triangle of `others` lies within it whole. Pieces that no one triangle covers are
+/// split in four, until each is covered, or a corner is farther than `limit` from all of
+/// `others` (then `t` is not within), or the pieces reach `MAX_DEPTH` (then `t` is refused
+/// though it may be within: the box stays unit cubes, which costs triangles only). The test is
+/// therefore exact where it accepts, with no sampling slack.
+pub(crate) fn within(t: [[f64; 3]; 3], others: &(impl Nearby + ?Sized), limit: f64) -> bool {
+    let tris = others.tris();
+    if limit.is_nan() || limit <= 0.0 || tris.is_empty() {
         return false;
     }
-    let len2 =
-        |a: [f64; 3], b: [f64; 3]| (0..3).map(|d| (a[d] - b[d]) * (a[d] - b[d])).sum::<f64>();
-    let longest = sqrt(len2(t[0], t[1]).max(len2(t[1], t[2])).max(len2(t[2], t[0])));
-    let sqrt3 = sqrt(3.0);
-    let n = ((longest / (sqrt3 * 0.25 * limit)) as usize + 1).min(64);
-    let slack = longest / (n as f64 * sqrt3);
-    let reach = limit - slack;
-    if reach <= 0.0 {
-        return false;
-    }
-    let reach2 = reach * reach;
-    // Neighbouring samples are usually near the same triangle: try the last one found first.
+    let limit2 = limit * limit;
+    let mid = |a: [f64; 3], b: [f64; 3]| core::array::from_fn(|d| 0.5 * (a[d] + b[d]));
+    let grown = |lo: [f64; 3], hi: [f64; 3]| -> ([f64; 3], [f64; 3]) {
+        (lo.map(|c| c - limit), hi.map(|c| c + limit))
+    };
+    // Depth-first: at most three pieces wait per level.
+    let mut stack = [([[0.0; 3]; 3], 0usize); 3 * MAX_DEPTH + 1];
+    stack[0] = (t, 0);
+    let mut waiting = 1;
+    // Neighbouring pieces are usually near the same triangle: try the last one that covered.
     let mut last = 0;
-    for i in 0..=n {
-        for j in 0..=n - i {
-            let (s, r) = (i as f64 / n as f64, j as f64 / n as f64);
-            let p: [f64; 3] = core::array::from_fn(|d| {
-                t[0][d] + s * (t[1][d] - t[0][d]) + r * (t[2][d] - t[0][d])
-            });
-            let near = |o: &[[f64; 3]; 3]| point_triangle_distance_squared(p, *o) <= reach2;
-            if others.get(last).is_some_and(near) {
-                continue;
-            }
-            match others.iter().position(near) {
-                Some(k) => last = k,
-                None => return false,
-            }
+    while waiting > 0 {
+        waiting -= 1;
+        let (piece, depth) = stack[waiting];
+        let covers = |k: usize| piece.iter().all(|&p| near(p, &tris[k], limit2));
+        if covers(last) {
+            continue;
+        }
+        let lo = core::array::from_fn(|d| piece[0][d].min(piece[1][d]).min(piece[2][d]));
+        let hi = core::array::from_fn(|d| piece[0][d].max(piece[1][d]).max(piece[2][d]));
+        let (lo, hi) = grown(lo, hi);
+        if let Some(k) = others.find(lo, hi, covers) {
+            last = k;
+            continue;
+        }
+        let reached = |p: [f64; 3]| {
+            let (lo, hi) = grown(p, p);
+            others.find(lo, hi, |k| near(p, &tris[k], limit2)).is_some()
+        };
+        if depth == MAX_DEPTH || !piece.iter().all(|&p| reached(p)) {
+            return false;
+        }
+        let [a, b, c] = piece;
+        let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+        for q in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
+            stack[waiting] = (q, depth + 1);
+            waiting += 1;
         }
     }
     true
+}
+
+/// Whether `p` lies within `√limit2` of triangle `o`; its bounding box rules most triangles out
+/// at a fraction of the exact distance's cost.
+#[inline]
+fn near(p: [f64; 3], o: &[[f64; 3]; 3], limit2: f64) -> bool {
+    let mut outside2 = 0.0;
+    for d in 0..3 {
+        let lo = o[0][d].min(o[1][d]).min(o[2][d]);
+        let hi = o[0][d].max(o[1][d]).max(o[2][d]);
+        let gap = (lo - p[d]).max(p[d] - hi).max(0.0);
+        outside2 += gap * gap;
+    }
+    outside2 <= limit2 && point_triangle_distance_squared(p, *o) <= limit2
 }
 
 /// The shape of a triangle, from 0 (degenerate) to 1 (equilateral): `48 · area² / (Σ side²)²`.

@@ -83,6 +83,23 @@ impl Vertex {
     }
 }
 
+/// A box's Steps 1–3 triangles in a [`Tolerance`]'s units, grouped by unit cube, so that (E)
+/// measures a point against the triangles of the cubes near it only.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Patch<'a> {
+    /// The triangles, cube by cube.
+    pub tris: &'a [[[f64; 3]; 3]],
+    /// Cube `c`'s triangles are `tris[starts[c]..starts[c + 1]]`, `c = x + side · (y + side · z)`
+    /// in cubes from the box's corner.
+    pub starts: &'a [u32],
+    /// The box's lower corner, in samples.
+    pub corner: [usize; 3],
+    /// The box's side, in cubes.
+    pub side: usize,
+    /// Multiplies each coordinate in grid steps (the tolerance's scale).
+    pub scale: [f64; 3],
+}
+
 /// How far a box's triangles may depart from Steps 1–3's: distances in grid steps scaled per
 /// axis (the spacing, for an error bound in world units; ones for voxels) up to `limit`, and
 /// whether samples may end up on the wrong side.

@@ -10,9 +10,9 @@
 //! function of the box's samples and its variant alone: the variant tested when the box was
 //! accepted is the one emitted.
 
-use super::checks::{faces_up, in_wall, quality, separates, simple_projection, within_bound};
+use super::checks::{Memo, faces_up, in_wall, quality, separates, simple_projection, within_bound};
 use super::outline::Outline;
-use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Tolerance, Vertex};
+use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Patch, Tolerance, Vertex};
 
 /// A box's triangles, wound filled → empty.
 #[derive(Clone, Debug)]
@@ -210,8 +210,9 @@ pub(crate) fn triangulate(
     src: &impl BoxSource,
     outline: &Outline,
     refined: u8,
-    patch: &[[[f64; 3]; 3]],
+    patch: &Patch<'_>,
     tolerance: &Tolerance,
+    memo: &mut Memo,
 ) -> Option<Triangulation> {
     let (polygon, m) = outline.polygon(refined);
     if !simple_projection(&polygon[..m], outline.axis) {
@@ -246,12 +247,12 @@ pub(crate) fn triangulate(
             index += 1;
         });
         let Some(t) = found else { continue };
-        if passes(src, outline, refined, &t, patch, tolerance) {
+        if passes(src, outline, refined, &t, patch, tolerance, memo) {
             return Some(t);
         }
     }
     best_whole(outline, &polygon[..m])
-        .filter(|t| passes(src, outline, refined, t, patch, tolerance))
+        .filter(|t| passes(src, outline, refined, t, patch, tolerance, memo))
 }
 
 /// (P), unless the tolerance allows wrong-side samples, and (E).
@@ -260,11 +261,12 @@ fn passes(
     outline: &Outline,
     refined: u8,
     t: &Triangulation,
-    patch: &[[[f64; 3]; 3]],
+    patch: &Patch<'_>,
     tolerance: &Tolerance,
+    memo: &mut Memo,
 ) -> bool {
     (tolerance.allow_wrong_side || separates(src, outline, refined, t.triangles()))
-        && within_bound(t.triangles(), patch, tolerance)
+        && within_bound(t.triangles(), patch, tolerance, memo)
 }
 
 /// Whether the box can be emitted in every variant its neighbours may give it: bit `i` of
@@ -273,16 +275,26 @@ pub(crate) fn accept(
     src: &impl BoxSource,
     outline: &Outline,
     may_chord: u8,
-    patch: &[[[f64; 3]; 3]],
+    patch: &Patch<'_>,
     tolerance: &Tolerance,
 ) -> bool {
     let with_mids = (0..outline.n)
         .filter(|&i| outline.has_mids(i))
         .fold(0u8, |m, i| m | 1 << i);
     let free = may_chord & with_mids;
+    let mut memo = Memo::new();
     let mut chords = free;
     loop {
-        if triangulate(src, outline, with_mids & !chords, patch, tolerance).is_none() {
+        if triangulate(
+            src,
+            outline,
+            with_mids & !chords,
+            patch,
+            tolerance,
+            &mut memo,
+        )
+        .is_none()
+        {
             return false;
         }
         if chords == 0 {
