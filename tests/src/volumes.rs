@@ -228,6 +228,28 @@ pub fn sub_box<T: Copy>(data: &[T], dims: [usize; 3], r: &[Range<usize>; 3]) -> 
     out
 }
 
+/// The blocks of a grid of `cubes` cubes per axis between consecutive cuts (cube indices; those
+/// outside `1 .. cubes` are ignored), x fastest.
+pub fn blocks_between(cubes: [usize; 3], cuts: &[Vec<usize>; 3]) -> Vec<[Range<usize>; 3]> {
+    let ranges: Vec<Vec<Range<usize>>> = (0..3)
+        .map(|d| {
+            let mut ends = vec![0];
+            ends.extend(cuts[d].iter().copied().filter(|&c| c > 0 && c < cubes[d]));
+            ends.push(cubes[d]);
+            ends.windows(2).map(|w| w[0]..w[1]).collect()
+        })
+        .collect();
+    let mut out = Vec::new();
+    for z in &ranges[2] {
+        for y in &ranges[1] {
+            for x in &ranges[0] {
+                out.push([x.clone(), y.clone(), z.clone()]);
+            }
+        }
+    }
+    out
+}
+
 /// Integer noise in `0..levels` at an integer iso in the middle: many samples equal iso exactly,
 /// the SPEC §1 tie case (every third sample or so when `levels` is 3).
 pub fn integer_noise(dims: [usize; 3], levels: u8, seed: u64) -> Vol<u8> {

@@ -10,7 +10,7 @@ use sc_runtime::labels::{
     Atlas, AtlasBlock, LabelParams, block_samples, extract_block, extract_labels,
 };
 use sc_runtime::{Error, Mode, Volume};
-use sc_tests::volumes::{label_noise, splitmix, sub_box, voronoi_labels};
+use sc_tests::volumes::{blocks_between, label_noise, splitmix, sub_box, voronoi_labels};
 
 /// The modes a label volume has.
 const MODES: [Mode; 3] = [Mode::Embedded, Mode::Paper, Mode::Steps123];
@@ -57,27 +57,6 @@ fn share(vol: &Labels, params: &LabelParams<u16>, cubes: [Range<usize>; 3]) -> A
     .unwrap_or_else(|e| panic!("block {cubes:?}: {e}"))
 }
 
-/// The blocks between consecutive cuts (cube indices) on each axis.
-fn blocks(cubes: [usize; 3], cuts: &[Vec<usize>; 3]) -> Vec<[Range<usize>; 3]> {
-    let ranges: Vec<Vec<Range<usize>>> = (0..3)
-        .map(|d| {
-            let mut ends = vec![0];
-            ends.extend(cuts[d].iter().copied().filter(|&c| c > 0 && c < cubes[d]));
-            ends.push(cubes[d]);
-            ends.windows(2).map(|w| w[0]..w[1]).collect()
-        })
-        .collect();
-    let mut out = Vec::new();
-    for z in &ranges[2] {
-        for y in &ranges[1] {
-            for x in &ranges[0] {
-                out.push([x.clone(), y.clone(), z.clone()]);
-            }
-        }
-    }
-    out
-}
-
 /// Meshes every block, then joins the shares in an order and grouping drawn from `seed`: two
 /// to four shares at a time, by `merge` or `merge_all`.
 fn joined(
@@ -86,7 +65,7 @@ fn joined(
     cuts: &[Vec<usize>; 3],
     seed: u64,
 ) -> Atlas<u16> {
-    let mut parts: Vec<AtlasBlock<u16>> = blocks(vol.cubes(params.pad), cuts)
+    let mut parts: Vec<AtlasBlock<u16>> = blocks_between(vol.cubes(params.pad), cuts)
         .into_iter()
         .map(|b| share(vol, params, b))
         .collect();
