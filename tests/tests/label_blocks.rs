@@ -1,11 +1,13 @@
 //! Label volumes meshed in blocks: a volume cut into blocks of any shape (one cube thick, not
 //! aligned to the sweep's pieces of 16 layers), each meshed from exactly the samples
 //! `block_samples` asks for, and the shares joined in any order, gives `extract_labels`'s atlas
-//! bit for bit — in every mode, padded or not, smoothed or not. A halo one sample short, cubes
+//! bit for bit — in every mode, padded or not, smoothed or not, on chosen and random volumes and
+//! cuts. A halo one sample short, cubes
 //! outside the grid, overlapping, missing or mismatched shares are refused.
 
 use std::ops::Range;
 
+use proptest::prelude::*;
 use sc_runtime::labels::{
     Atlas, AtlasBlock, LabelParams, block_samples, extract_block, extract_labels,
 };
@@ -216,6 +218,32 @@ fn smoothed_blocks_join_exactly() {
             &cuts[1..],
             &format!("noise smoothed {smoothing}"),
         );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    /// Any volume (one sample thick included), any cuts, any setting.
+    #[test]
+    fn random_volumes_cuts_and_settings_join_exactly(
+        dims in prop::array::uniform3(1usize..11),
+        labels in 2u64..6,
+        seed in 0u64..1 << 40,
+        cut_bits in any::<u64>(),
+        pad in any::<bool>(),
+        mode in prop::sample::select(MODES.to_vec()),
+        smoothing in prop::sample::select(vec![0.0, 0.4, 1.1]),
+    ) {
+        let vol = Labels { data: label_noise(dims, labels, seed), dims };
+        let params = params(mode, pad, smoothing);
+        let whole = extract_labels(vol.volume(), &params).unwrap();
+        // Each cube index is a cut with probability 1/4.
+        let mut bit = 0;
+        let cuts = vol.cubes(pad).map(|n| {
+            (1..n).filter(|_| { bit += 2; cut_bits >> (bit % 64) & 3 == 0 }).collect()
+        });
+        let got = joined(&vol, &params, &cuts, seed);
+        assert_same(&got, &whole, &format!("{dims:?} {mode:?} pad {pad} σ {smoothing} {cuts:?}"));
     }
 }
 
