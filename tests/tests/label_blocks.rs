@@ -2,8 +2,8 @@
 //! aligned to the sweep's pieces of 16 layers), each meshed from exactly the samples
 //! `block_samples` asks for, and the shares joined in any order, gives `extract_labels`'s atlas
 //! bit for bit — in every mode, padded or not, smoothed or not, on chosen and random volumes and
-//! cuts. A halo one sample short, cubes
-//! outside the grid, overlapping, missing or mismatched shares are refused.
+//! cuts. A halo one sample short, cubes outside the grid, overlapping, missing or mismatched
+//! shares are refused.
 
 use std::ops::Range;
 
