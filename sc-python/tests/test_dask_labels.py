@@ -103,10 +103,11 @@ def test_numpy_input_a_single_chunk_and_a_delayed_result():
 
 
 def test_a_volume_one_sample_thick():
-    v = volume((1, 9, 8), 4, 3)
-    for pad in (True, False):
-        same(skelclimb.dask.labels(da.from_array(v, chunks=3), pad=pad),
-             skelclimb.labels(v, pad=pad))
+    for dtype in ("u1", "i8"):
+        v = volume((1, 9, 8), 4, 3).astype(dtype)
+        for pad in (True, False):
+            same(skelclimb.dask.labels(da.from_array(v, chunks=3), pad=pad),
+                 skelclimb.labels(v, pad=pad))
 
 
 @pytest.mark.parametrize("dtype", ["f4", "f8", "?"])

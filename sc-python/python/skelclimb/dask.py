@@ -264,6 +264,7 @@ def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=
     background = _index(background, "background")
     dtype = array.dtype
     target = _label_type(dtype, background, lambda: _bounds(array), array.size, "array")
+    source = array
     if target != dtype:
         array = array.astype(target)
     selection = _selection(labels)
@@ -292,7 +293,7 @@ def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=
 
         from . import labels as whole
 
-        result = dask.delayed(whole)(array, **given)
+        result = dask.delayed(whole)(source, **given)
         return result.compute() if compute else result
     return _run(array, name, blocks, shares, token, split_every, compute, _label_merge,
                 lambda share: _label_finish(share, finish))
