@@ -135,9 +135,9 @@ pub fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
     let vec1 = |a: &PyReadonlyArray1<'_, u64>| a.as_array().to_vec();
     let keys = vec1(&keys);
     let cubes = vec1(&cubes);
-    let positions = triples(&positions).ok_or_else(|| bad("positions are not (V, 3)"))?;
-    let normals = triples(&normals).ok_or_else(|| bad("normals are not (V, 3)"))?;
-    let triangles = triples(&triangles).ok_or_else(|| bad("faces are not (T, 3)"))?;
+    let positions = rows(&positions).ok_or_else(|| bad("positions are not (V, 3)"))?;
+    let normals = rows(&normals).ok_or_else(|| bad("normals are not (V, 3)"))?;
+    let triangles = rows(&triangles).ok_or_else(|| bad("faces are not (T, 3)"))?;
     let share = BlockMesh {
         grid,
         keys,
@@ -152,12 +152,13 @@ pub fn from_python(obj: &Bound<'_, PyAny>) -> PyResult<BlockMesh> {
     Ok(share)
 }
 
-fn triples<T: Element + Copy>(a: &PyReadonlyArray2<'_, T>) -> Option<Vec<[T; 3]>> {
+/// The rows of an `(n, N)` array, or `None` if it has another width.
+pub fn rows<T: Element + Copy, const N: usize>(a: &PyReadonlyArray2<'_, T>) -> Option<Vec<[T; N]>> {
     let view = a.as_array();
-    (view.ncols() == 3 || view.nrows() == 0).then(|| {
+    (view.ncols() == N || view.nrows() == 0).then(|| {
         view.rows()
             .into_iter()
-            .map(|r| [r[0], r[1], r[2]])
+            .map(|r| core::array::from_fn(|k| r[k]))
             .collect()
     })
 }

@@ -99,12 +99,7 @@ where
         smoothing,
         selection,
     } = request;
-    let dtype = numpy::dtype::<L>(py);
-    let background = background.extract::<L>().map_err(|_| {
-        PyValueError::new_err(format!(
-            "background: {background} is not a value of the volume's type ({dtype})"
-        ))
-    })?;
+    let background = label::<L>(&background)?;
     let params = LabelParams {
         background,
         mode: extract::mode(mode_name)?,
@@ -115,7 +110,7 @@ where
         smoothing,
         ..LabelParams::default()
     };
-    let mut atlas = {
+    let atlas = {
         let samples = convert::samples::<L>(volume, "volume")?;
         let data = samples
             .as_slice()
@@ -124,14 +119,60 @@ where
         py.detach(|| extract_labels(volume, &params))
             .map_err(errors::runtime)?
     };
+    let reply = Reply {
+        dims,
+        world,
+        background,
+        mode: mode_name,
+        normals,
+        selection,
+    };
+    respond(py, atlas, reply)
+}
+
+/// `background` as a label of the volume's type `L`.
+pub fn label<'py, L: Label + Element + FromPyObjectOwned<'py>>(
+    background: &Bound<'py, PyAny>,
+) -> PyResult<L> {
+    background.extract::<L>().map_err(|_| {
+        PyValueError::new_err(format!(
+            "background: {background} is not a value of the volume's type ({})",
+            numpy::dtype::<L>(background.py())
+        ))
+    })
+}
+
+/// What [`respond`] needs besides the atlas.
+pub struct Reply<'a, 'py, L> {
+    /// The volume's samples along x, y, z.
+    pub dims: [usize; 3],
+    pub world: World,
+    pub background: L,
+    pub mode: &'a str,
+    pub normals: bool,
+    pub selection: Option<Vec<Bound<'py, PyAny>>>,
+}
+
+/// [`labels`]'s result from an atlas made at `index × spacing + origin`, however it was made
+/// (in one sweep, or joined from blocks).
+pub fn respond<'py, L>(
+    py: Python<'py>,
+    mut atlas: Atlas<L>,
+    reply: Reply<'_, 'py, L>,
+) -> PyResult<Bound<'py, PyTuple>>
+where
+    L: Label + Element + Display + FromPyObjectOwned<'py> + IntoPyObject<'py>,
+{
+    let (world, background, mode_name, normals) =
+        (&reply.world, reply.background, reply.mode, reply.normals);
     if !world.is_translation() {
-        py.detach(|| place(&world, &mut atlas));
+        py.detach(|| place(world, &mut atlas));
     }
-    let chosen = choose(&atlas.labels(background), background, selection)?;
+    let chosen = choose(&atlas.labels(background), background, reply.selection)?;
     let meshes = py.detach(|| atlas.meshes(&chosen, normals));
 
     let stats = PyDict::new(py);
-    stats.set_item("dims", dims)?;
+    stats.set_item("dims", reply.dims)?;
     stats.set_item("background", background)?;
     extract::report(&stats, &atlas.stats, mode_name, world.space)?;
     let per_label = meshes

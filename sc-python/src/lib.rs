@@ -8,6 +8,7 @@ mod convert;
 mod errors;
 mod extract;
 mod files;
+mod label_blocks;
 mod labels;
 mod recycle;
 mod shards;
@@ -37,6 +38,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(blocks::extract_block, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::merge_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::finish_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(label_blocks::extract_label_block, m)?)?;
+    m.add_function(wrap_pyfunction!(label_blocks::merge_label_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(label_blocks::label_block_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(label_blocks::finish_label_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(shards::write_shard, m)?)?;
     m.add_function(wrap_pyfunction!(shards::write_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(shards::merge_shards, m)?)?;

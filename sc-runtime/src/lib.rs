@@ -46,7 +46,9 @@ pub use mesh::Mesh;
 /// cube constructions are `no_std`; [`labels::extract_labels`] needs `alloc`.
 pub mod labels {
     #[cfg(feature = "alloc")]
-    pub use crate::drivers::labels::{Atlas, Label, LabelParams, extract_labels};
+    pub use crate::drivers::labels::{
+        Atlas, AtlasBlock, Label, LabelParams, block_samples, extract_block, extract_labels,
+    };
     pub use crate::kernel::labels::*;
 }
 

@@ -2,6 +2,8 @@
 //! embedded-mode rule, and small crops of real scans (committed under `tests/data/`, embedded
 //! with `include_bytes!` so no test reads outside the crate).
 
+use std::ops::Range;
+
 use sc_runtime::demo::DemoVolume;
 use sc_runtime::{Mesh, Mode, Params, Scalar, Volume};
 
@@ -177,6 +179,75 @@ pub fn splitmix(i: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
+}
+
+/// Independent labels in `0..labels` per sample: the most junctions a label volume can have.
+pub fn label_noise(dims: [usize; 3], labels: u64, seed: u64) -> Vec<u16> {
+    let n = dims.iter().product::<usize>();
+    (0..n)
+        .map(|i| (splitmix(seed * 1_000_003 + i as u64) % labels) as u16)
+        .collect()
+}
+
+/// The Voronoi cells of `count` random seeds as labels, every fourth cell the background 0:
+/// regions large enough for Step 4 to merge, with junction curves between them.
+pub fn voronoi_labels(dims: [usize; 3], count: u64, seed: u64) -> Vec<u16> {
+    let seeds: Vec<[f64; 3]> = (0..count)
+        .map(|s| {
+            [0, 1, 2].map(|a| {
+                (splitmix(seed * 7919 + s * 3 + a as u64) % 10_000) as f64 / 10_000.0
+                    * dims[a] as f64
+            })
+        })
+        .collect();
+    let mut data = vec![];
+    for z in 0..dims[2] {
+        for y in 0..dims[1] {
+            for x in 0..dims[0] {
+                let p = [x as f64, y as f64, z as f64];
+                let d = |s: &[f64; 3]| (0..3).map(|a| (s[a] - p[a]).powi(2)).sum::<f64>();
+                let best = (0..seeds.len())
+                    .min_by(|&a, &b| d(&seeds[a]).total_cmp(&d(&seeds[b])))
+                    .unwrap();
+                data.push(if best % 4 == 3 { 0 } else { 1 + best as u16 });
+            }
+        }
+    }
+    data
+}
+
+/// The samples of the box `r` (per axis) of a volume of `dims`, copied out, x fastest.
+pub fn sub_box<T: Copy>(data: &[T], dims: [usize; 3], r: &[Range<usize>; 3]) -> Vec<T> {
+    let [nx, ny, _] = dims;
+    let mut out = Vec::with_capacity(r.iter().map(|r| r.len()).product());
+    for z in r[2].clone() {
+        for y in r[1].clone() {
+            out.extend_from_slice(&data[nx * (y + ny * z)..][r[0].clone()]);
+        }
+    }
+    out
+}
+
+/// The blocks of a grid of `cubes` cubes per axis between consecutive cuts (cube indices; those
+/// outside `1 .. cubes` are ignored), x fastest.
+pub fn blocks_between(cubes: [usize; 3], cuts: &[Vec<usize>; 3]) -> Vec<[Range<usize>; 3]> {
+    let ranges: Vec<Vec<Range<usize>>> = (0..3)
+        .map(|d| {
+            let mut ends = vec![0];
+            ends.extend(cuts[d].iter().copied().filter(|&c| c > 0 && c < cubes[d]));
+            ends.push(cubes[d]);
+            ends.windows(2).map(|w| w[0]..w[1]).collect()
+        })
+        .collect();
+    let mut out = Vec::new();
+    for z in &ranges[2] {
+        for y in &ranges[1] {
+            for x in &ranges[0] {
+                out.push([x.clone(), y.clone(), z.clone()]);
+            }
+        }
+    }
+    out
 }
 
 /// Integer noise in `0..levels` at an integer iso in the middle: many samples equal iso exactly,

@@ -10,25 +10,14 @@ use sc_runtime::{
     BlockMesh, Error, Mesh, Mode, Params, Volume, block_samples, demo, extract, extract_block,
 };
 use sc_tests::volumes::{
-    self, Sample, Vol, brainsmall_crop, integer_noise, itk_t1_crop, splitmix, stent_crop,
+    self, Sample, Vol, blocks_between, brainsmall_crop, integer_noise, itk_t1_crop, splitmix,
+    stent_crop, sub_box,
 };
-
-/// The samples of `r` (per axis) copied out of the volume, x fastest.
-fn sub_box<T: Sample>(vol: &Vol<T>, r: &[Range<usize>; 3]) -> Vec<T> {
-    let [nx, ny, _] = vol.dims;
-    let mut out = Vec::with_capacity(r.iter().map(|r| r.len()).product());
-    for z in r[2].clone() {
-        for y in r[1].clone() {
-            out.extend_from_slice(&vol.data[nx * (y + ny * z)..][r[0].clone()]);
-        }
-    }
-    out
-}
 
 /// One block's share, meshed from exactly the samples `block_samples` asks for.
 fn share<T: Sample>(vol: &Vol<T>, params: &Params, cubes: [Range<usize>; 3]) -> BlockMesh {
     let need = block_samples(vol.dims, cubes.clone()).expect("cubes inside the grid");
-    let data = sub_box(vol, &need);
+    let data = sub_box(&vol.data, vol.dims, &need);
     let dims = need.clone().map(|r| r.len());
     let samples = Volume::new(&data, dims).expect("box");
     extract_block(
@@ -41,31 +30,10 @@ fn share<T: Sample>(vol: &Vol<T>, params: &Params, cubes: [Range<usize>; 3]) -> 
     .unwrap_or_else(|e| panic!("block {cubes:?}: {e}"))
 }
 
-/// Blocks between consecutive cuts on each axis (cuts are cube indices, strictly inside).
-fn blocks(dims: [usize; 3], cuts: &[Vec<usize>; 3]) -> Vec<[Range<usize>; 3]> {
-    let ranges: Vec<Vec<Range<usize>>> = (0..3)
-        .map(|d| {
-            let mut edges = vec![0];
-            edges.extend(cuts[d].iter().copied());
-            edges.push(dims[d] - 1);
-            edges.windows(2).map(|w| w[0]..w[1]).collect()
-        })
-        .collect();
-    let mut out = Vec::new();
-    for z in &ranges[2] {
-        for y in &ranges[1] {
-            for x in &ranges[0] {
-                out.push([x.clone(), y.clone(), z.clone()]);
-            }
-        }
-    }
-    out
-}
-
 /// Meshes every block, then joins the shares in an order and tree shape drawn from `seed`: each
 /// join takes two to five shares at once.
 fn joined<T: Sample>(vol: &Vol<T>, params: &Params, cuts: &[Vec<usize>; 3], seed: u64) -> Mesh {
-    let mut parts: Vec<BlockMesh> = blocks(vol.dims, cuts)
+    let mut parts: Vec<BlockMesh> = blocks_between(vol.dims.map(|n| n - 1), cuts)
         .into_iter()
         .map(|b| share(vol, params, b))
         .collect();
@@ -207,7 +175,7 @@ fn a_halo_one_sample_short_is_refused() {
                 } else {
                     r[axis].start += 1;
                 }
-                let data = sub_box(&vol, &r);
+                let data = sub_box(&vol.data, vol.dims, &r);
                 let samples = Volume::new(&data, r.clone().map(|r| r.len())).expect("box");
                 let got = extract_block(
                     &samples,

@@ -12,7 +12,7 @@ use sc_runtime::{Mode, Params, Volume};
 use sc_tests::geometry::{signed_volume, winding_and_distance};
 use sc_tests::self_intersect::self_intersections;
 use sc_tests::topology::manifold_problems;
-use sc_tests::volumes::splitmix;
+use sc_tests::volumes::{label_noise, voronoi_labels};
 
 /// The modes a label volume has: every one but adaptive, which `extract_labels` refuses
 /// (tests/adaptive.rs).
@@ -390,39 +390,13 @@ impl Labels {
     }
 }
 
-/// Independent labels per sample: the most junctions a volume can have.
 fn noise(dims: [usize; 3], labels: u64, seed: u64) -> Labels {
-    let n = dims.iter().product::<usize>();
-    let data = (0..n)
-        .map(|i| (splitmix(seed * 1_000_003 + i as u64) % labels) as u16)
-        .collect();
+    let data = label_noise(dims, labels, seed);
     Labels { data, dims }
 }
 
-/// Voronoi cells of a few random seeds, with some cells given the background: regions large
-/// enough for Step 4 to merge, with junction curves between them.
 fn cells(dims: [usize; 3], count: u64, seed: u64) -> Labels {
-    let seeds: Vec<[f64; 3]> = (0..count)
-        .map(|s| {
-            [0, 1, 2].map(|a| {
-                (splitmix(seed * 7919 + s * 3 + a as u64) % 10_000) as f64 / 10_000.0
-                    * dims[a] as f64
-            })
-        })
-        .collect();
-    let mut data = vec![];
-    for z in 0..dims[2] {
-        for y in 0..dims[1] {
-            for x in 0..dims[0] {
-                let p = [x as f64, y as f64, z as f64];
-                let d = |s: &[f64; 3]| (0..3).map(|a| (s[a] - p[a]).powi(2)).sum::<f64>();
-                let best = (0..seeds.len())
-                    .min_by(|&a, &b| d(&seeds[a]).total_cmp(&d(&seeds[b])))
-                    .unwrap();
-                data.push(if best % 4 == 3 { 0 } else { 1 + best as u16 });
-            }
-        }
-    }
+    let data = voronoi_labels(dims, count, seed);
     Labels { data, dims }
 }
 

@@ -101,27 +101,42 @@ class Labels(Mapping):
 
 def _label_volume(volume, background):
     """``volume`` as a 3-D array of a label type the native code borrows, and its own dtype."""
-    if isinstance(volume, np.ndarray) and volume.dtype.kind not in "iu":
-        raise TypeError(
-            f"volume holds {volume.dtype}; label volumes need integers "
-            "(uint8, uint16, uint32, uint64, int16, int32; other integer types are converted)"
-        )
+    if isinstance(volume, np.ndarray):
+        _integers(volume.dtype, "volume")
     volume = _volume(volume)
     dtype = volume.dtype
+    target = _label_type(dtype, background, lambda: (volume.min(), volume.max()), volume.size,
+                         "volume")
+    # astype keeps the memory order, so the axes read the same.
+    return (volume if target == dtype else volume.astype(target)), dtype
+
+
+def _integers(dtype, name):
+    """A ``TypeError`` naming ``name`` unless ``dtype`` is an integer type."""
+    if dtype.kind not in "iu":
+        raise TypeError(
+            f"{name} holds {dtype}; label volumes need integers "
+            "(uint8, uint16, uint32, uint64, int16, int32; other integer types are converted)"
+        )
+
+
+def _label_type(dtype, background, bounds, size, name):
+    """The label type a volume of integer ``dtype`` is meshed as: its own if the runtime takes
+    it, else the smallest that holds its values and the background; ``bounds()`` gives the
+    values' least and greatest, and is only called then (``size``: the number of samples)."""
     info = np.iinfo(dtype)
     if not info.min <= background <= info.max:
-        raise ValueError(f"background: {background} is not a value of the volume's {dtype}")
+        raise ValueError(f"background: {background} is not a value of the {name}'s {dtype}")
     if dtype in _LABEL_TYPES:
-        return volume, dtype
-    low = min(int(volume.min()), background) if volume.size else background
-    high = max(int(volume.max()), background) if volume.size else background
+        return dtype
+    low, high = (int(b) for b in bounds()) if size else (background, background)
+    low, high = min(low, background), max(high, background)
     for target in _LABEL_TYPES:
         t = np.iinfo(target)
         if t.min <= low and high <= t.max:
-            # astype keeps the memory order, so the axes read the same.
-            return volume.astype(target), dtype
+            return target
     raise ValueError(
-        f"volume: its {dtype} labels run from {low} to {high}, which no label type holds "
+        f"{name}: its {dtype} labels run from {low} to {high}, which no label type holds "
         "(uint8, uint16, uint32, uint64, int16, int32)"
     )
 
@@ -226,11 +241,16 @@ def labels(
     selection = _selection(labels)
     affine, spacing, origin = _placement(affine, spacing, origin)
     _mode(mode)
-    verts, faces, face_labels, meshes, stats = _native.labels(
+    return _result(_native.labels(
         volume, spacing, origin, background, mode, bool(pad), bool(normals), threads,
         _smoothing(smoothing), selection,
         None if affine is None else affine[:3].tolist(), space,
-    )
+    ), dtype)
+
+
+def _result(native, dtype):
+    """The :class:`Labels` of what ``_native.labels`` returns, its labels of ``dtype``."""
+    verts, faces, face_labels, meshes, stats = native
     if face_labels.dtype != dtype:
         face_labels = face_labels.astype(dtype)
     return Labels(

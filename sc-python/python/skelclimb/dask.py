@@ -26,26 +26,25 @@ import numpy as np
 from . import _native
 from ._blocks import extract_block
 
-__all__ = ["extract"]
+__all__ = ["extract", "labels"]
 
-# Samples past a chunk's far side that its cubes read (see skelclimb.block_samples).
-_AFTER = 3
+# Samples before and past a chunk's sides that its cubes read (see skelclimb.block_samples).
+_BEFORE, _AFTER = 1, 3
 
 
 # A neighbour's place relative to a block, per axis (z, y, x): -1 before it, +1 after it.
 _OFFSETS = [tuple(c - 1 for c in o) for o in np.ndindex(3, 3, 3) if o != (1, 1, 1)]
 
-# What a block needs of a neighbour along an axis where the neighbour lies before it (its last
-# sample), level with it (all of it), or after it (its first _AFTER samples).
-_PICK = {-1: slice(-1, None), 0: slice(None), 1: slice(0, _AFTER)}
 
-
-def _shell(block):
+def _shell(block, before, after):
     """The pieces of ``block`` its 26 neighbours read, one per offset in ``_OFFSETS`` (the
     offset at which the reading block sees this one): thin faces, edges and corners, copied so
-    that they do not keep the chunk alive."""
+    that they do not keep the chunk alive. Along an axis, a neighbour after this block reads
+    its last ``before`` samples, one level with it all of them, one before it its first
+    ``after``."""
+    pick = {-1: slice(-before, None), 0: slice(None), 1: slice(0, after)}
     b = np.asarray(block)
-    return [b[tuple(_PICK[c] for c in o)].copy() for o in _OFFSETS]
+    return [b[tuple(pick[c] for c in o)].copy() for o in _OFFSETS]
 
 
 def _extended(block, shells):
@@ -75,8 +74,9 @@ def _extended(block, shells):
     return out
 
 
-def _mesh(block, at, grid, cubes, options, *shells):
+def _mesh(block, at, grid, cubes, *shells_and_options):
     """Meshes a block from its chunk and its neighbours' shells."""
+    *shells, options = shells_and_options
     return extract_block(_extended(block, shells), at=at, grid=grid, cubes=cubes, **options)
 
 
@@ -88,10 +88,11 @@ def _native_settings(options):
             bool(options["normals"]), _bound(options["max_error"], options["error_units"]))
 
 
-def _shard(directory, block, at, grid, cubes, options, *shells):
+def _shard(directory, block, at, grid, cubes, *shells_and_options):
     """Meshes one block and writes it as a shard; returns only the manifest's small record, so
     the worker keeps no mesh."""
-    share = _mesh(block, at, grid, cubes, options, *shells)
+    options = shells_and_options[-1]
+    share = _mesh(block, at, grid, cubes, *shells_and_options)
     return _native.write_shard(share._share, directory, cubes, _native_settings(options))
 
 
@@ -107,13 +108,18 @@ def _finish(share):
     return share.to_mesh()
 
 
-def _cube_ranges(chunks, n):
-    """Per chunk along one axis, the cubes it owns: those whose lower corner it holds."""
-    out, start = [], 0
-    for size in chunks:
-        out.append((start, min(start + size, n - 1)))
-        start += size
-    return out
+def _starts(chunks):
+    """Each chunk's first sample along one axis."""
+    return np.cumsum((0,) + tuple(chunks[:-1])).tolist()
+
+
+def _cube_ranges(chunks, n, pad=False):
+    """Per chunk along one axis, the cubes it owns: those whose lower corner it holds. With
+    ``pad``, the grid's cubes are those of the padded grid, cube ``c`` lying between samples
+    ``c - 1`` and ``c``: the first chunk also owns cube 0, whose lower corner is padding."""
+    if not pad:
+        return [(s, min(s + size, n - 1)) for s, size in zip(_starts(chunks), chunks)]
+    return [(0 if s == 0 else s + 1, s + size + 1) for s, size in zip(_starts(chunks), chunks)]
 
 
 def _at_least(chunks, m):
@@ -171,12 +177,9 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     >>> bool((joined.vertices == whole.vertices).all() and (joined.faces == whole.faces).all())
     True
     """
-    import dask
     from dask.base import tokenize
-    from dask.delayed import Delayed
-    from dask.highlevelgraph import HighLevelGraph, MaterializedLayer
 
-    from . import _MODES, _bound, _index, _level, _triple
+    from . import _MODES, _bound, _level, _triple
 
     array = _dask_array(array)
     level = _level(level)
@@ -185,9 +188,7 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         raise ValueError(f"mode: expected one of {', '.join(map(repr, _MODES))}, got {mode!r}")
     if array.ndim != 3:
         raise ValueError(f"array: expected 3 dimensions, got {array.ndim}")
-    split_every = _index(split_every, "split_every")
-    if split_every < 2:
-        raise ValueError(f"split_every: must be at least 2, got {split_every}")
+    split_every = _split_every(split_every)
     nz, ny, nx = array.shape
     grid = (nx, ny, nz)
     if min(grid) < 2:
@@ -195,44 +196,163 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     _bound(max_error, error_units)
     options = dict(level=level, spacing=spacing, origin=origin, mode=mode, normals=normals,
                    max_error=max_error, error_units=error_units)
-    # Each block's task gets its chunk plus the halo extract_block reads (one sample before, up
-    # to three after), cut from its 26 neighbours' shells (see _shell): three tasks per chunk
-    # (read, shell, mesh) where dask.array.overlap makes some 24, and every chunk read once.
-    array = array.rechunk(tuple(_at_least(c, _AFTER) for c in array.chunks))
+    directory = None if shards is None else os.fspath(shards)
+    if directory is not None:
+        os.makedirs(directory, exist_ok=True)
+    token = tokenize(array.name, options, split_every, directory)
+    array, name, blocks, shares = _blocks(
+        array, token, _BEFORE, _AFTER, False,
+        lambda *task: (_mesh, *task, options) if directory is None
+        else (_shard, directory, *task, options))
+    return _run(array, name, blocks, shares, token, split_every, compute, _merge, _finish,
+                directory=directory, grid=grid, options=options)
+
+
+def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=None,
+           background=0, mode="embedded", pad=True, normals=True, smoothing=0, split_every=8,
+           compute=True):
+    """Meshes every region of a 3-D integer ``dask.array``, block by block: exactly what
+    :func:`skelclimb.labels` makes of the whole array.
+
+    Each task reads its chunk plus a halo (two samples before, three after; with
+    ``smoothing``, one more than the Gaussian's reach ``ceil(3 * smoothing)`` when that is
+    further) and meshes the cubes it owns into a share of the atlas; a tree of merges joins the
+    shares, and the meshes per label are cut from the joined atlas where the result is wanted.
+
+    Parameters
+    ----------
+    array : dask.array.Array or numpy.ndarray
+        Axes ``(z, y, x)``, as for :func:`skelclimb.dask.extract`. uint8, uint16, uint32,
+        uint64, int16 and int32 are meshed as they are; other integer types are converted to
+        the smallest of those holding every value and the background, which costs one more
+        pass over the array to find its least and greatest label. Float and bool arrays are a
+        ``TypeError``.
+    affine, space, spacing, origin, labels, background, mode, pad, normals, smoothing
+        As for :func:`skelclimb.labels`.
+    split_every : int
+        How many shares each merge task joins (the fan-in of the reduction tree).
+    compute : bool
+        Return the result; with ``False``, a ``dask.delayed`` object that computes it.
+
+    Returns
+    -------
+    skelclimb.Labels
+        Equal, vertex for vertex and triangle for triangle, to ``skelclimb.labels`` of the
+        whole array with the same arguments, whatever the chunking.
+
+    Examples
+    --------
+    >>> import dask.array as da, numpy as np, skelclimb, skelclimb.dask
+    >>> v = np.zeros((12, 12, 12), np.uint8); v[2:9, 2:9, 2:6] = 1; v[2:9, 2:9, 6:10] = 2
+    >>> joined = skelclimb.dask.labels(da.from_array(v, chunks=5))
+    >>> whole = skelclimb.labels(v)
+    >>> bool((joined.atlas.vertices == whole.atlas.vertices).all()) and joined.labels()
+    [1, 2]
+    """
+    from dask.base import tokenize
+
+    from . import _index, _mode, _placement
+    from ._labels import _integers, _label_type, _selection, _smoothing
+
+    given = dict(affine=affine, space=space, spacing=spacing, origin=origin, labels=labels,
+                 background=background, mode=mode, pad=pad, normals=normals,
+                 smoothing=smoothing)
+    array = _dask_array(array)
+    if array.ndim != 3:
+        raise ValueError(f"array: expected 3 dimensions, got {array.ndim}")
+    _integers(array.dtype, "array")
+    background = _index(background, "background")
+    dtype = array.dtype
+    target = _label_type(dtype, background, lambda: _bounds(array), array.size, "array")
+    source = array
+    if target != dtype:
+        array = array.astype(target)
+    selection = _selection(labels)
+    affine, spacing, origin = _placement(affine, spacing, origin)
+    _mode(mode)
+    smoothing = _smoothing(smoothing)
+    split_every = _split_every(split_every)
+    affine = None if affine is None else affine[:3].tolist()
+    nz, ny, nx = array.shape
+    grid = (nx, ny, nz)
+    pad = bool(pad)
+    # The halo, from the samples the runtime says a block in the middle of a large grid reads.
+    middle = ((50, 51),) * 3
+    need = _native.label_block_samples((100,) * 3, middle, pad, smoothing)[0]
+    before, after = 50 - pad - need[0], need[1] - 51 + pad
+    block = dict(spacing=spacing, origin=origin, background=background, mode=mode, pad=pad,
+                 smoothing=smoothing, affine=affine, space=space)
+    finish = dict(background=background, mode=mode, normals=bool(normals), selection=selection,
+                  affine=affine, space=space, dtype=dtype)
+    token = tokenize(array.name, block, finish, split_every)
+    array, name, blocks, shares = _blocks(
+        array, token, before, after, pad, lambda *task: (_label_mesh, *task, block))
+    if not shares:
+        # No cube at all (an axis of one sample, unpadded): no blocks to split it into.
+        import dask
+
+        from . import labels as whole
+
+        result = dask.delayed(whole)(source, **given)
+        return result.compute() if compute else result
+    return _run(array, name, blocks, shares, token, split_every, compute, _label_merge,
+                lambda share: _label_finish(share, finish))
+
+
+def _blocks(array, token, before, after, pad, task):
+    """The tasks meshing ``array`` block by block: ``(array, name, blocks, shares)``, the array
+    rechunked so that a halo comes from one neighbour, the blocks' layer name, its tasks (the
+    shells, then ``task(chunk, at, grid, cubes, *shells)`` per chunk owning cubes, keyed
+    ``(name, *idx)``) and those blocks' keys. A block's task gets its chunk plus the halo it
+    reads, ``before`` samples before it and ``after`` past it, cut from its 26 neighbours'
+    shells (see _shell): three tasks per chunk (read, shell, mesh) where dask.array.overlap
+    makes some 24, and every chunk read once."""
+    array = array.rechunk(tuple(_at_least(c, max(before, after)) for c in array.chunks))
+    nz, ny, nx = array.shape
+    grid = (nx, ny, nz)
     # The graph is written out here, task by task, rather than by calling dask.delayed
     # functions: each such call merges and culls its arguments' graphs, which grows with the
     # number of tasks and dominates a large array's graph building.
     keys = array.__dask_keys__()
     shape = tuple(len(c) for c in array.chunks)
     chunks = {idx: keys[idx[0]][idx[1]][idx[2]] for idx in np.ndindex(shape)}
-    directory = None if shards is None else os.fspath(shards)
-    token = tokenize(array.name, options, split_every, directory)
     shell = "skelclimb-shell-" + token
     blocks = {}
     if shape != (1, 1, 1):
-        blocks = {(shell, *idx): (_shell, chunks[idx]) for idx in np.ndindex(shape)}
+        blocks = {(shell, *idx): (_shell, chunks[idx], before, after)
+                  for idx in np.ndindex(shape)}
 
     def shells(idx):
         near = [tuple(i + c for i, c in zip(idx, o)) for o in _OFFSETS]
         return [(shell, *n) if all(0 <= i < m for i, m in zip(n, shape)) else None for n in near]
 
     name = "skelclimb-block-" + token
-    if directory is not None:
-        os.makedirs(directory, exist_ok=True)
     shares = []
     zc, yc, xc = array.chunks
-    for iz, cz in enumerate(_cube_ranges(zc, nz)):
-        for iy, cy in enumerate(_cube_ranges(yc, ny)):
-            for ix, cx in enumerate(_cube_ranges(xc, nx)):
+    starts = [_starts(c) for c in (xc, yc, zc)]
+    for iz, cz in enumerate(_cube_ranges(zc, nz, pad)):
+        for iy, cy in enumerate(_cube_ranges(yc, ny, pad)):
+            for ix, cx in enumerate(_cube_ranges(xc, nx, pad)):
                 if cz[0] == cz[1] or cy[0] == cy[1] or cx[0] == cx[1]:
                     continue
-                cubes = (cx, cy, cz)
-                at = tuple(max(c[0] - 1, 0) for c in cubes)
+                first = (starts[0][ix], starts[1][iy], starts[2][iz])
+                at = tuple(max(s - before, 0) for s in first)
                 idx = (iz, iy, ix)
-                task = (chunks[idx], at, grid, cubes, options, *shells(idx))
                 key = (name, *idx)
-                blocks[key] = (_mesh, *task) if directory is None else (_shard, directory, *task)
+                blocks[key] = task(chunks[idx], at, grid, (cx, cy, cz), *shells(idx))
                 shares.append(key)
+    return array, name, blocks, shares
+
+
+def _run(array, name, blocks, shares, token, split_every, compute, merge, finish,
+         directory=None, grid=None, options=None):
+    """Runs the blocks' graph: their shares joined by ``merge`` in a tree of fan-in
+    ``split_every``, the last join and ``finish`` here (or, without ``compute``, a delayed
+    object doing both); with ``directory``, the shards' manifest's path instead."""
+    import dask
+    from dask.delayed import Delayed
+    from dask.highlevelgraph import HighLevelGraph, MaterializedLayer
+
     layers = dict(array.__dask_graph__().layers)
     dependencies = dict(array.__dask_graph__().dependencies)
     # Lower z layers first: a distributed worker then meshes and drops a layer's chunks before
@@ -251,12 +371,12 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
             merged = []
             for i in range(0, len(shares), split_every):
                 key = ("skelclimb-merge-" + token, level_key, len(merged))
-                joins[key] = (_merge, *shares[i:i + split_every])
+                joins[key] = (merge, *shares[i:i + split_every])
                 merged.append(key)
             shares, level_key = merged, level_key + 1
         if not compute:
-            joins["skelclimb-mesh-" + token] = (_merge, *shares)
-            joins["skelclimb-finish-" + token] = (_finish, "skelclimb-mesh-" + token)
+            joins["skelclimb-mesh-" + token] = (merge, *shares)
+            joins["skelclimb-finish-" + token] = (finish, "skelclimb-mesh-" + token)
             shares = ["skelclimb-finish-" + token]
     if joins:
         last = "skelclimb-join-" + token
@@ -268,7 +388,45 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         return results[0].compute() if compute else results[0]
     # The last merge runs here, where the mesh is wanted anyway, so that no worker has to hold
     # the whole mesh (and its inputs) on top of its chunks.
-    return _finish(_merge(*dask.compute(*results)))
+    return finish(merge(*dask.compute(*results)))
+
+
+def _split_every(split_every):
+    from . import _index
+
+    split_every = _index(split_every, "split_every")
+    if split_every < 2:
+        raise ValueError(f"split_every: must be at least 2, got {split_every}")
+    return split_every
+
+
+def _bounds(array):
+    """The least and greatest value of a ``dask.array``, in one pass."""
+    import dask
+
+    return dask.compute(array.min(), array.max())
+
+
+def _label_mesh(block, at, grid, cubes, *shells_and_options):
+    """Meshes a block of a label volume from its chunk and its neighbours' shells."""
+    *shells, o = shells_and_options
+    samples = np.ascontiguousarray(_extended(block, shells))
+    return _native.extract_label_block(
+        samples, at, grid, cubes, o["spacing"], o["origin"], o["background"], o["mode"],
+        o["pad"], o["smoothing"], o["affine"], o["space"])
+
+
+def _label_merge(*shares):
+    return _native.merge_label_blocks(list(shares)) if len(shares) > 1 else shares[0]
+
+
+def _label_finish(share, o):
+    """The :class:`skelclimb.Labels` of the joined shares."""
+    from ._labels import _result
+
+    return _result(_native.finish_label_blocks(
+        share, o["background"], o["mode"], o["normals"], o["selection"], o["affine"],
+        o["space"]), o["dtype"])
 
 
 def _dask_array(array):

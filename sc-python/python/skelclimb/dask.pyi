@@ -1,6 +1,8 @@
-from typing import Any
+from typing import Any, Iterable, Optional
 
-from . import Mesh, _Mode, _Path, _Triple
+import numpy.typing as npt
+
+from . import Labels, Mesh, _Mode, _Path, _Space, _Triple
 
 def extract(
     array: Any,
@@ -16,3 +18,19 @@ def extract(
     shards: _Path | None = ...,
     compute: bool = ...,
 ) -> Mesh | str | Any: ...
+def labels(
+    array: Any,
+    *,
+    affine: Optional[npt.ArrayLike] = ...,
+    space: _Space = ...,
+    spacing: Optional[_Triple] = ...,
+    origin: Optional[_Triple] = ...,
+    labels: Optional[Iterable[int]] = ...,
+    background: int = ...,
+    mode: _Mode = ...,
+    pad: bool = ...,
+    normals: bool = ...,
+    smoothing: float = ...,
+    split_every: int = ...,
+    compute: bool = ...,
+) -> Labels | Any: ...

@@ -45,7 +45,7 @@ pub fn block_samples(
     }))
 }
 
-fn check_cubes(grid: [usize; 3], cubes: &[Range<usize>; 3]) -> Result<(), Error> {
+pub(crate) fn check_cubes(grid: [usize; 3], cubes: &[Range<usize>; 3]) -> Result<(), Error> {
     for (d, r) in cubes.iter().enumerate() {
         if r.start > r.end || r.end > grid[d].saturating_sub(1) {
             return Err(Error::BlockOutsideGrid {
@@ -84,7 +84,7 @@ pub fn edge_key(grid: [usize; 3], lower: [usize; 3], axis: usize) -> u64 {
 }
 
 /// The global name of a cube (by its lower corner), in the order a sweep visits cubes.
-fn cube_key(grid: [usize; 3], [i, j, k]: [usize; 3]) -> u64 {
+pub(crate) fn cube_key(grid: [usize; 3], [i, j, k]: [usize; 3]) -> u64 {
     let [nx, ny, _] = grid.map(|n| n as u64);
     ((k as u64) * ny + j as u64) * nx + i as u64
 }
@@ -216,16 +216,7 @@ pub(crate) fn sweep_block<T: Scalar>(
 ) -> Result<BlockMesh, Error> {
     let need = block_samples(grid, cubes.clone())?;
     let dims = samples.dims();
-    for d in 0..3 {
-        let have = at[d]..at[d].saturating_add(dims[d]);
-        if have.start > need[d].start || have.end < need[d].end || have.end > grid[d] {
-            return Err(Error::HaloTooSmall {
-                axis: d,
-                have,
-                need: need[d].clone(),
-            });
-        }
-    }
+    check_halo(dims, at, grid, &need)?;
     let mut out = BlockMesh {
         grid,
         covered: cubes.iter().map(|r| r.len() as u64).product(),
@@ -283,30 +274,69 @@ pub(crate) fn sweep_block<T: Scalar>(
     Ok(out)
 }
 
+/// [`BlockMesh::check`] on a share's parts: its keys, the lengths of its positions and normals
+/// (if any), its triangles and their owning cubes.
+pub(crate) fn check_share(
+    keys: &[u64],
+    positions: usize,
+    normals: Option<usize>,
+    triangles: &[[u32; 3]],
+    cubes: &[u64],
+) -> Result<(), Error> {
+    let n = keys.len();
+    let broken = |what| Err(Error::BlockMalformed { what });
+    if positions != n || normals.is_some_and(|m| m != n) {
+        return broken("the vertex arrays differ in length");
+    }
+    if cubes.len() != triangles.len() {
+        return broken("the triangle and owning-cube arrays differ in length");
+    }
+    if !keys.windows(2).all(|w| w[0] < w[1]) {
+        return broken("the vertex keys are not strictly increasing");
+    }
+    if !cubes.windows(2).all(|w| w[0] <= w[1]) {
+        return broken("the owning cubes are not in order");
+    }
+    if !triangles.iter().flatten().all(|&v| (v as usize) < n) {
+        return broken("a triangle refers to a vertex that is not there");
+    }
+    Ok(())
+}
+
+/// Refuses samples of `dims` from grid index `at` that do not cover `need` or leave the grid.
+pub(crate) fn check_halo(
+    dims: [usize; 3],
+    at: [usize; 3],
+    grid: [usize; 3],
+    need: &[Range<usize>; 3],
+) -> Result<(), Error> {
+    for d in 0..3 {
+        let have = at[d]..at[d].saturating_add(dims[d]);
+        if have.start > need[d].start || have.end < need[d].end || have.end > grid[d] {
+            return Err(Error::HaloTooSmall {
+                axis: d,
+                have,
+                need: need[d].clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl BlockMesh {
     /// Checks the rules [`BlockMesh::merge`] relies on, for a share that crossed a process or a
     /// file and may have been damaged on the way: one position (and normal, if any) per key, keys
     /// strictly increasing, one owning cube per triangle in non-decreasing order, and every
     /// triangle's indices inside the vertex list. A share from [`extract_block`] always passes.
     pub fn check(&self) -> Result<(), Error> {
-        let n = self.keys.len();
-        let broken = |what| Err(Error::BlockMalformed { what });
-        if self.positions.len() != n || !(self.normals.is_empty() || self.normals.len() == n) {
-            return broken("the vertex arrays differ in length");
-        }
-        if self.cubes.len() != self.triangles.len() {
-            return broken("the triangle and owning-cube arrays differ in length");
-        }
-        if !self.keys.windows(2).all(|w| w[0] < w[1]) {
-            return broken("the vertex keys are not strictly increasing");
-        }
-        if !self.cubes.windows(2).all(|w| w[0] <= w[1]) {
-            return broken("the owning cubes are not in order");
-        }
-        if !self.triangles.iter().flatten().all(|&v| (v as usize) < n) {
-            return broken("a triangle refers to a vertex that is not there");
-        }
-        Ok(())
+        let normals = (!self.normals.is_empty()).then_some(self.normals.len());
+        check_share(
+            &self.keys,
+            self.positions.len(),
+            normals,
+            &self.triangles,
+            &self.cubes,
+        )
     }
 
     /// Joins two shares of the same grid into one: the union of their vertices (in key order)
@@ -334,18 +364,29 @@ impl BlockMesh {
     /// assert_eq!(whole, extract(&volume, &params).unwrap());
     /// ```
     pub fn merge_all(shares: impl IntoIterator<Item = BlockMesh>) -> Result<BlockMesh, Error> {
-        let shares: Vec<BlockMesh> = shares
-            .into_iter()
-            .filter(|s| s.covered != 0 || !s.keys.is_empty())
-            .collect();
-        let Some(first) = shares.first() else {
+        Self::merge_traced(shares.into_iter().collect(), |_, _| {})
+    }
+
+    /// [`BlockMesh::merge_all`], calling `origin(share, triangle)` for each triangle of the
+    /// result, in order: where it came from, for data kept beside the shares (a label's pair).
+    pub(crate) fn merge_traced(
+        shares: Vec<BlockMesh>,
+        mut origin: impl FnMut(usize, usize),
+    ) -> Result<BlockMesh, Error> {
+        // Empty shares (the default one a fold starts from) join anything.
+        let live = || {
+            shares
+                .iter()
+                .filter(|s| s.covered != 0 || !s.keys.is_empty())
+        };
+        let Some(first) = live().next() else {
             return Ok(BlockMesh::default());
         };
         let with_vertices = || shares.iter().filter(|s| !s.keys.is_empty());
         let normals = with_vertices()
             .next()
             .is_some_and(|s| !s.normals.is_empty());
-        if shares.iter().any(|s| s.grid != first.grid)
+        if live().any(|s| s.grid != first.grid)
             || with_vertices().any(|s| s.normals.is_empty() == normals)
         {
             return Err(Error::BlocksDiffer);
@@ -392,6 +433,7 @@ impl BlockMesh {
                 out.cubes.push(share.cubes[at]);
                 out.triangles
                     .push(share.triangles[at].map(|v| maps[s][v as usize]));
+                origin(s, at);
             }
         });
         match overlap {

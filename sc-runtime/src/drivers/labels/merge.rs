@@ -17,13 +17,14 @@ use super::{Atlas, Label, LabelParams};
 use crate::Mode;
 
 /// Merges what may merge among `ears`, then drops the vertices and triangles merged away;
-/// returns each old vertex's new id (`u32::MAX` if dropped), if any ear was looked at.
+/// returns, if any ear was looked at, each old vertex's new id (`u32::MAX` if dropped) and
+/// which old triangles were dropped.
 pub(super) fn merge<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
     ears: Vec<Ear<L>>,
     atlas: &mut Atlas<L>,
-) -> Option<Vec<u32>> {
+) -> Option<(Vec<u32>, Vec<bool>)> {
     if ears.is_empty() {
         return None;
     }
@@ -54,7 +55,8 @@ pub(super) fn merge<L: Label>(
         gone_vertex[a.vertex as usize] = true;
         atlas.stats.merged += 1;
     }
-    Some(compact(atlas, &gone_vertex, &gone_triangle))
+    let kept = compact(atlas, &gone_vertex, &gone_triangle);
+    Some((kept, gone_triangle))
 }
 
 /// `decide` for every group, on threads unless one was asked for.

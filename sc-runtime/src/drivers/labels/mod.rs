@@ -4,13 +4,15 @@
 //! [`extract_labels`] sweeps the volume cube by cube ([`sweep`]), then merges grey edges where
 //! the volume is locally two-labelled ([`merge`]). The result, an [`Atlas`], holds each
 //! interface once, tagged with its two labels; [`Atlas::meshes`] cuts it into one closed mesh
-//! per label.
+//! per label. [`extract_block`] meshes one block of a volume into a share ([`blocks`]); shares
+//! join into that same atlas.
 
 use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::{Error, Mesh, Mode, Stats, Volume};
 
+mod blocks;
 mod join;
 mod merge;
 mod smooth;
@@ -20,6 +22,8 @@ use core::ops::Range;
 
 use crate::kernel::labels::MAX_SMOOTHING;
 use sweep::Padded;
+
+pub use blocks::{AtlasBlock, block_samples, extract_block};
 
 /// A sample type that can hold labels: an integer whose values name regions.
 pub trait Label: Copy + Ord + Send + Sync + core::fmt::Debug + 'static + sealed::Sealed {
@@ -110,14 +114,7 @@ pub fn extract_labels<L: Label>(
     volume: Volume<'_, L>,
     params: &LabelParams<L>,
 ) -> Result<Atlas<L>, Error> {
-    if !(0.0..=MAX_SMOOTHING).contains(&params.smoothing) {
-        return Err(Error::Smoothing);
-    }
-    if params.mode == Mode::Adaptive {
-        return Err(Error::NotAdaptive {
-            what: "label volumes have no adaptive mode (use embedded, paper or steps123)",
-        });
-    }
+    check(params)?;
     let grid = Padded::new(volume, params);
     let layers = grid.n[2].saturating_sub(1);
     let ranges: Vec<Range<usize>> = if grid.n.iter().all(|&n| n >= 2) {
@@ -133,16 +130,29 @@ pub fn extract_labels<L: Label>(
         let (mut atlas, ears, mut edges, mut pinned) = join::join(pieces);
         atlas.stats.v13 = atlas.positions.len() as u64;
         atlas.stats.t13 = atlas.triangles.len() as u64;
-        if let Some(kept) = merge::merge(&grid, params, ears, &mut atlas) {
+        if let Some((kept, _)) = merge::merge(&grid, params, ears, &mut atlas) {
             renumber(&mut edges, &mut pinned, &kept);
         }
         if params.smoothing > 0.0 {
-            smooth::place(&grid, params, &mut atlas, &edges, &pinned);
+            smooth::place(&grid, params, &mut atlas.positions, &edges, &pinned);
         }
         atlas.stats.vertices = atlas.positions.len() as u64;
         atlas.stats.triangles = atlas.triangles.len() as u64;
         Ok(atlas)
     })?
+}
+
+/// Refuses what no label extraction runs: a smoothing width out of range, adaptive mode.
+fn check<L>(params: &LabelParams<L>) -> Result<(), Error> {
+    if !(0.0..=MAX_SMOOTHING).contains(&params.smoothing) {
+        return Err(Error::Smoothing);
+    }
+    if params.mode == Mode::Adaptive {
+        return Err(Error::NotAdaptive {
+            what: "label volumes have no adaptive mode (use embedded, paper or steps123)",
+        });
+    }
+    Ok(())
 }
 
 /// Runs `job` where Rayon's threads are the number asked for: its global pool when it has
@@ -200,12 +210,12 @@ fn sweep_pieces<L: Label>(
     if params.threads == 1 {
         return ranges
             .into_iter()
-            .map(|r| sweep::sweep(grid, params, r))
+            .map(|r| sweep::sweep(grid, params, whole(grid, r), false))
             .collect();
     }
     ranges
         .par_iter()
-        .map(|r| sweep::sweep(grid, params, r.clone()))
+        .map(|r| sweep::sweep(grid, params, whole(grid, r.clone()), false))
         .collect()
 }
 
@@ -218,8 +228,13 @@ fn sweep_pieces<L: Label>(
 ) -> Result<Vec<sweep::Piece<L>>, Error> {
     ranges
         .into_iter()
-        .map(|r| sweep::sweep(grid, params, r))
+        .map(|r| sweep::sweep(grid, params, whole(grid, r), false))
         .collect()
+}
+
+/// Every cube of the layers `layers`.
+fn whole<L: Label>(grid: &Padded<'_, L>, layers: Range<usize>) -> [Range<usize>; 3] {
+    [0..grid.n[0] - 1, 0..grid.n[1] - 1, layers]
 }
 
 /// An empty atlas, for any label type (a derived `Default` would ask `L: Default`).

@@ -5,23 +5,29 @@
 use alloc::vec::Vec;
 
 use super::sweep::{Edge, NOT_ON_AN_EDGE, Padded};
-use super::{Atlas, Label, LabelParams};
+use super::{Label, LabelParams};
 
 /// How far inside its edge a vertex stays, as a fraction of the edge: what keeps triangles from
 /// thinning to slivers where the smoothed indicators cross near a sample.
 const INSIDE: f64 = 1.0 / 32.0;
 
-/// Moves the vertices on grid edges (`edges`, per vertex) but those `pinned`.
+/// How far, in samples, the Gaussian of width `sigma` reads: three widths either side hold all
+/// but 0.3 % of the weight.
+pub(super) fn reach(sigma: f64) -> usize {
+    libm::ceil(3.0 * sigma) as usize
+}
+
+/// Moves the vertices on grid edges (`edges`, per vertex) but those `pinned`. Reads the grid up
+/// to [`reach`] samples from each edge's ends.
 pub(super) fn place<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
-    atlas: &mut Atlas<L>,
+    positions: &mut [[f32; 3]],
     edges: &[Edge],
     pinned: &[u32],
 ) {
     let sigma = params.smoothing;
-    // Three widths either side hold all but 0.3 % of the weight.
-    let reach = libm::ceil(3.0 * sigma) as isize;
+    let reach = reach(sigma) as isize;
     let weights: Vec<f64> = (-reach..=reach)
         .map(|d| libm::exp(-((d * d) as f64) / (2.0 * sigma * sigma)))
         .collect();
@@ -71,6 +77,6 @@ pub(super) fn place<L: Label>(
             0.5
         };
         let at = lower[axis] as f64 + t;
-        atlas.positions[v][axis] = (params.origin[axis] + (at - pad) * params.spacing[axis]) as f32;
+        positions[v][axis] = (params.origin[axis] + (at - pad) * params.spacing[axis]) as f32;
     }
 }

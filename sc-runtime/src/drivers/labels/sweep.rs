@@ -30,10 +30,15 @@ pub(super) struct Ear<L> {
     pub axis: usize,
 }
 
-/// The volume as the sweep sees it: with a border of background when padded.
+/// The volume as the sweep sees it: with a border of background when padded. It may hold a
+/// window of the volume only (a block and its halo); indices are always the whole padded grid's.
 pub(super) struct Padded<'a, L> {
     data: &'a [L],
+    /// The samples `data` holds along each axis, and the volume index of its first.
     dims: [usize; 3],
+    at: [usize; 3],
+    /// The whole volume's samples along each axis.
+    volume: [usize; 3],
     pad: usize,
     pub background: L,
     /// Samples along each axis, the border included.
@@ -42,14 +47,26 @@ pub(super) struct Padded<'a, L> {
 
 impl<'a, L: Label> Padded<'a, L> {
     pub fn new(volume: Volume<'a, L>, params: &LabelParams<L>) -> Self {
-        let dims = volume.dims();
+        Self::window(volume, [0; 3], volume.dims(), params)
+    }
+
+    /// The part `samples` of a volume of `volume` samples, starting at volume index `at`: read
+    /// only where the caller checked it holds what is read.
+    pub fn window(
+        samples: Volume<'a, L>,
+        at: [usize; 3],
+        volume: [usize; 3],
+        params: &LabelParams<L>,
+    ) -> Self {
         let pad = usize::from(params.pad);
         Padded {
-            data: volume.data(),
-            dims,
+            data: samples.data(),
+            dims: samples.dims(),
+            at,
+            volume,
             pad,
             background: params.background,
-            n: dims.map(|d| d + 2 * pad),
+            n: volume.map(|d| d + 2 * pad),
         }
     }
 
@@ -58,34 +75,37 @@ impl<'a, L: Label> Padded<'a, L> {
     pub fn at(&self, p: [usize; 3]) -> L {
         let mut q = [0; 3];
         for a in 0..3 {
-            if p[a] < self.pad || p[a] >= self.dims[a] + self.pad {
+            if p[a] < self.pad || p[a] >= self.volume[a] + self.pad {
                 return self.background;
             }
-            q[a] = p[a] - self.pad;
+            q[a] = p[a] - self.pad - self.at[a];
         }
         self.data[q[0] + self.dims[0] * (q[1] + self.dims[1] * q[2])]
     }
 
-    /// Copies plane `z` of the padded grid into `out` (`n[0] · n[1]` long).
-    pub fn plane(&self, z: usize, out: &mut [L]) {
-        let [nx, ny, _] = self.n;
+    /// Copies the samples `xs × ys` of plane `z` of the padded grid into `out`, row by row.
+    pub fn plane(&self, z: usize, xs: Range<usize>, ys: Range<usize>, out: &mut [L]) {
+        let w = xs.len();
         let [dx, dy, _] = self.dims;
-        if z < self.pad || z >= self.dims[2] + self.pad {
+        // The columns inside the volume, as indices into a row of `out`.
+        let x0 = xs.start.max(self.pad).min(xs.end);
+        let x1 = xs.end.min(self.volume[0] + self.pad).max(x0);
+        if z < self.pad || z >= self.volume[2] + self.pad {
             out.fill(self.background);
             return;
         }
-        let slice = &self.data[(z - self.pad) * dx * dy..][..dx * dy];
-        for y in 0..ny {
-            let row = &mut out[y * nx..][..nx];
-            if y < self.pad || y >= dy + self.pad {
+        let slice = &self.data[(z - self.pad - self.at[2]) * dx * dy..][..dx * dy];
+        for (r, y) in ys.enumerate() {
+            let row = &mut out[r * w..][..w];
+            if y < self.pad || y >= self.volume[1] + self.pad {
                 row.fill(self.background);
                 continue;
             }
-            row[self.pad..self.pad + dx].copy_from_slice(&slice[(y - self.pad) * dx..][..dx]);
-            if self.pad > 0 {
-                row[0] = self.background;
-                row[nx - 1] = self.background;
-            }
+            let src = &slice[(y - self.pad - self.at[1]) * dx..][..dx];
+            let from = |x: usize| x - self.pad - self.at[0];
+            row[..x0 - xs.start].fill(self.background);
+            row[x0 - xs.start..x1 - xs.start].copy_from_slice(&src[from(x0)..from(x1)]);
+            row[x1 - xs.start..].fill(self.background);
         }
     }
 
@@ -192,7 +212,8 @@ impl Ids {
         (&mut self.slots[offset + at], self.since[plane])
     }
 
-    /// [`Ids::edge`] for the centre of face `f` of the cube `[i, j, k]`.
+    /// [`Ids::edge`] for the centre of face `f` of the cube `[i, j, k]` (`i`, `j` from the
+    /// box's corner).
     fn face(&mut self, cube: [usize; 3], f: u8) -> (&mut u32, u32) {
         let side = usize::from(f % 2);
         let [i, j, k] = cube;
@@ -285,18 +306,36 @@ pub(super) struct Piece<L> {
     /// With smoothing: per vertex its grid edge, and the vertices that stay (see `Out`).
     pub edges: Vec<Edge>,
     pub pinned: Vec<u32>,
+    /// When asked for, each cube with triangles, in sweep order (see [`Emitter`]).
+    pub emitters: Vec<Emitter>,
 }
 
-/// Steps 1–3 over `layers` of the padded grid. Vertices are numbered as the piece first uses
-/// them, from 0, so a piece depends only on its layers, not on where the sweep started.
+/// A cube that made triangles, and where its output starts: its triangles run to the next
+/// emitter's first, and so do the vertices it was the first to use. What a block needs to name
+/// vertices and triangles by the cube that made them.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Emitter {
+    pub cube: [usize; 3],
+    pub triangle: u32,
+    pub vertex: u32,
+}
+
+/// Steps 1–3 over the box `cubes` (lower corners, per axis) of the padded grid; with `record`,
+/// the piece lists its [`Emitter`]s. Vertices are numbered as the piece first uses them, from 0,
+/// so a piece depends only on its cubes, not on where the sweep started.
 pub(super) fn sweep<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
-    layers: Range<usize>,
+    cubes: [Range<usize>; 3],
+    record: bool,
 ) -> Result<Piece<L>, Error> {
-    let [nx, ny, _] = grid.n;
+    // The box's samples along x and y; indices into its planes are relative to its corner.
+    let [xs, ys] = [0, 1].map(|a| cubes[a].start..cubes[a].end + 1);
+    let (nx, ny) = (xs.len(), ys.len());
+    let layers = cubes[2].clone();
     let mut atlas = Atlas::default();
     let mut ears = Vec::new();
+    let mut emitters = Vec::new();
     let mut ids = Ids::new(nx, ny);
     let pad = f64::from(u8::from(params.pad));
     let mut out = Out {
@@ -316,13 +355,13 @@ pub(super) fn sweep<L: Label>(
     let mut mask = vec![0u8; nx - 1];
     let mut bottom = [Vec::new(), Vec::new(), Vec::new()];
     let first = layers.start;
-    grid.plane(first, &mut planes[first % 2]);
+    grid.plane(first, xs.clone(), ys.clone(), &mut planes[first % 2]);
     for k in layers.clone() {
         if k == first + 1 {
             bottom = ids.plane(first);
         }
         ids.start_layer(k, out.atlas.positions.len() as u32, k == first);
-        grid.plane(k + 1, &mut planes[(k + 1) % 2]);
+        grid.plane(k + 1, xs.clone(), ys.clone(), &mut planes[(k + 1) % 2]);
         let (lower, upper) = (&planes[k % 2], &planes[(k + 1) % 2]);
         for j in 0..ny - 1 {
             let rows = [
@@ -343,8 +382,15 @@ pub(super) fn sweep<L: Label>(
                     rows[3][i],
                     rows[3][i + 1],
                 ];
-                let cube = [i, j, k];
+                let cube = [xs.start + i, ys.start + j, k];
                 let here = i + nx * j;
+                if record {
+                    emitters.push(Emitter {
+                        cube,
+                        triangle: out.atlas.triangles.len() as u32,
+                        vertex: out.atlas.positions.len() as u32,
+                    });
+                }
                 let keys = labels.map(|l| grid.key(l));
                 let (kind, built) = match few_labels(&keys) {
                     Some(kind) => (kind, &[][..]),
@@ -353,7 +399,7 @@ pub(super) fn sweep<L: Label>(
                 match kind {
                     Kind::Uniform => {}
                     Kind::Binary { background, case } => {
-                        let class = (i & 1) | (j & 1) << 1 | (k & 1) << 2;
+                        let class = (cube[0] & 1) | (cube[1] & 1) << 1 | (k & 1) << 2;
                         let case_at = class * 256 + usize::from(case);
                         let entry = &table[case_at];
                         let w = labels[usize::from(background)];
@@ -405,7 +451,7 @@ pub(super) fn sweep<L: Label>(
                                     Local::Edge(e) => {
                                         edge_vertex(&mut ids, &mut out, cube, here, e)?
                                     }
-                                    Local::Face(f) => shared(ids.face(cube, f), || {
+                                    Local::Face(f) => shared(ids.face([i, j, k], f), || {
                                         out.vertex(cube, local.quarters())
                                     })?,
                                     Local::Centre | Local::InnerNode(_) | Local::InnerCorner(_) => {
@@ -450,6 +496,7 @@ pub(super) fn sweep<L: Label>(
         ears,
         bottom,
         top,
+        emitters,
     })
 }
 
