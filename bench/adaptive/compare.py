@@ -234,7 +234,7 @@ def main():
         variants += [(f"adaptive {e:g} wrong-side", v + ["--allow-wrong-side"])
                      for e, (_, v) in zip(a.max_error, list(variants))]
     report = {
-        "command": "python3 " + " ".join(shlex.quote(x) for x in [os.path.relpath(__file__, ROOT), *sys.argv[1:]]),
+        "command": " ".join(shlex.quote(x) for x in [sys.executable, os.path.relpath(__file__, ROOT), *sys.argv[1:]]),
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "machine": machine(),
         "allow_wrong_side_flag": wrong_flag,
@@ -278,11 +278,16 @@ def main():
                              "seconds_decimation": t, **measure(dec, steps, vol, sides, a.step)})
                 print(f"   FE+fs to {label}: {len(dec[1])} triangles, {t:.4f} s", file=sys.stderr, flush=True)
             target = meshes["ours " + variants[0][0]]
+            # Half as many: how far decimation goes before its distance reaches adaptive mode's.
+            t, dec = fast_decimate(fe, target // 2, a.repeat)
+            rows.append({"method": f"FE + fast_simplification to ½ of {variants[0][0]}", "seconds": t_fe + t,
+                         "seconds_decimation": t, **measure(dec, steps, vol, sides, a.step)})
             t, dec = vtk_decimate(fe_pd, target, a.repeat)
             rows.append({"method": f"FE + vtkQuadricDecimation to {variants[0][0]}", "seconds": t_fe + t,
                          "seconds_decimation": t, **measure(dec, steps, vol, sides, a.step)})
             report["volumes"].append({"name": vol.name, "dims": list(vol.arr.shape[::-1]), "iso": vol.iso,
                                       "padded": vol.padded, "spacing": vol.spacing.tolist(), "rows": rows})
+    report["machine"]["loadavg_at_end"] = os.getloadavg()
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "results.json"), "w") as f:
         json.dump(report, f, indent=1)
@@ -298,7 +303,9 @@ def upper(d):
 def markdown(r):
     m = r["machine"]
     lines = [
-        f"Run {r['date']} on {m['nproc']} cores ({m['cpu']}), shared; VTK {m['vtk']}, Python {m['python']}.",
+        f"Run {r['date']} on {m['nproc']} cores ({m['cpu']}), shared with other work (load average "
+        f"{m['loadavg_at_start'][1]:.1f} at the start, {m['loadavg_at_end'][1]:.1f} at the end, 5-minute); "
+        f"VTK {m['vtk']}, Python {m['python']}.",
         f"Command: `{r['command']}`.",
         f"`--allow-wrong-side` in this build: {'yes' if r['allow_wrong_side_flag'] else 'no'}.",
         f"Times: best of {r['repeat']}, one thread; ours is the `seconds.extract` of its stats JSON, "
