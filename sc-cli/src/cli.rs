@@ -226,7 +226,7 @@ pub struct ExtractArgs {
     /// mesh, neighbours sharing their interfaces exactly. `all` or a list such as `1,5,17-20`
     /// chooses which labels get a mesh.
     #[arg(long, value_name = "all|LIST", value_parser = sc_io::labels::Selection::parse,
-          conflicts_with_all = ["iso", "demo", "stream", "shards", "max_error", "max_box", "pad"])]
+          conflicts_with_all = ["iso", "demo", "stream", "shards", "max_error", "max_box", "allow_wrong_side", "pad"])]
     pub labels: Option<sc_io::labels::Selection>,
     /// With --labels: the label of no region, not meshed, and what lies outside the volume.
     #[arg(long, requires = "labels", default_value_t = 0)]
@@ -273,6 +273,10 @@ pub struct ExtractArgs {
     /// With --mode adaptive: the largest box, in cubes per side (1, 2, 4, 8 or 16; default 16).
     #[arg(long, value_parser = parse_max_box)]
     pub max_box: Option<u32>,
+    /// With --mode adaptive: let boxes leave samples on the wrong side of the surface, as the
+    /// 1998 paper does, for fewer triangles (by default every sample keeps its side).
+    #[arg(long)]
+    pub allow_wrong_side: bool,
     /// The units of `--max-error`.
     #[arg(
         long,

@@ -32,6 +32,8 @@ pub struct Request {
     pub max_error: Option<ErrorBound>,
     /// Adaptive mode's largest box, in cubes per side (its default if `None`).
     pub max_box: Option<u32>,
+    /// Adaptive mode: whether boxes may leave samples on the wrong side of the surface.
+    pub allow_wrong_side: bool,
 }
 
 impl Request {
@@ -45,6 +47,7 @@ impl Request {
             coordinates: Coordinates::Native,
             max_error: None,
             max_box: None,
+            allow_wrong_side: false,
         }
     }
 }
@@ -58,6 +61,7 @@ fn params(grid: &Grid, request: &Request, world: &World) -> Params {
     params.spacing = grid.spacing;
     params.max_error = request.max_error;
     params.max_box = request.max_box;
+    params.allow_wrong_side = request.allow_wrong_side;
     if world.is_translation() {
         params.origin = world.offset;
     }

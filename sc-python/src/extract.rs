@@ -107,7 +107,7 @@ pub fn params(
 /// world it maps to (`spacing` and `origin` are then ignored). Returns
 /// `(vertices, faces, normals or None, stats)`.
 #[pyfunction]
-#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads, max_error=None, affine=None, space=None))]
+#[pyo3(signature = (volume, level, spacing, origin, mode, normals, threads, max_error=None, affine=None, space=None, max_box=None, allow_wrong_side=false))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn extract<'py>(
     py: Python<'py>,
@@ -121,10 +121,16 @@ pub fn extract<'py>(
     max_error: Option<(f64, String)>,
     affine: Option<[[f64; 4]; 3]>,
     space: Option<&str>,
+    max_box: Option<u32>,
+    allow_wrong_side: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
     let threads = arguments::threads(threads)?;
     let (spacing, origin, world) = placement(spacing, origin, affine, space)?;
-    let params = params(level, spacing, origin, mode, normals, max_error)?;
+    let params = Params {
+        max_box,
+        allow_wrong_side,
+        ..params(level, spacing, origin, mode, normals, max_error)?
+    };
     let dims = convert::dims(volume, "volume")?;
     let mut mesh =
         with_element!(py, volume, "volume", T => run::<T>(py, volume, dims, &params, threads))?;

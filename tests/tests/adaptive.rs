@@ -206,10 +206,26 @@ fn wrong_side<T: Sample>(vol: &Vol<T>, mesh: &Mesh, reference: &Mesh) -> usize {
 /// Every check on one padded volume at one bound (in grid steps); returns the triangle counts
 /// (Steps 1–3, adaptive).
 fn holds<T: Sample>(vol: &Vol<T>, bound: f64, what: &str) -> (usize, usize) {
+    let (s123, ours, wrong) = holds_allowing(vol, bound, false, what);
+    assert_eq!(wrong, 0, "{what} at {bound} voxel");
+    (s123, ours)
+}
+
+/// Every check of `holds` but separation, which `allow_wrong_side` waives; returns the triangle
+/// counts (Steps 1–3, adaptive) and the samples on the wrong side.
+fn holds_allowing<T: Sample>(
+    vol: &Vol<T>,
+    bound: f64,
+    allow_wrong_side: bool,
+    what: &str,
+) -> (usize, usize, usize) {
     let steps123 = vol.extract(Mode::Steps123);
-    let params = adaptive_params(vol, ErrorBound::Voxels(bound));
+    let params = Params {
+        allow_wrong_side,
+        ..adaptive_params(vol, ErrorBound::Voxels(bound))
+    };
     let mesh = run(vol, &params);
-    let what = format!("{what} at {bound} voxel");
+    let what = format!("{what} at {bound} voxel, allow_wrong_side {allow_wrong_side}");
     assert_eq!(mesh.stats.t13, steps123.triangles.len() as u64, "{what}");
     assert_eq!(mesh.stats.triangles, mesh.triangles.len() as u64, "{what}");
     assert_eq!(mesh.stats.vertices, mesh.positions.len() as u64, "{what}");
@@ -259,8 +275,30 @@ fn holds<T: Sample>(vol: &Vol<T>, bound: f64, what: &str) -> (usize, usize) {
         there / least,
         back / least,
     );
-    assert_eq!(wrong, 0, "{what}");
-    (steps123.triangles.len(), mesh.triangles.len())
+    (steps123.triangles.len(), mesh.triangles.len(), wrong)
+}
+
+/// Waiving separation keeps every other check and never costs triangles; on the smooth demo
+/// volumes it saves some.
+#[test]
+fn allowing_wrong_side_holds_the_other_checks() {
+    for (v, what) in [
+        (demo::sphere(48), "sphere 48³"),
+        (demo::torus(48), "torus 48³"),
+        (demo::knot(64), "knot 64³"),
+    ] {
+        let vol = volumes::demo(v);
+        for bound in [0.5, 1.0] {
+            let (_, kept, _) = holds_allowing(&vol, bound, false, what);
+            let (_, allowed, _) = holds_allowing(&vol, bound, true, what);
+            assert!(allowed <= kept, "{what} at {bound}: {allowed} > {kept}");
+            if what != "knot 64³" {
+                assert!(allowed < kept, "{what} at {bound}: nothing saved");
+            }
+        }
+    }
+    let b = brainsmall_crop().padded(0);
+    holds_allowing(&b, 0.5, true, "brainsmall crop");
 }
 
 #[test]
@@ -391,14 +429,21 @@ fn bad_options_are_refused() {
     .unwrap();
     assert_eq!(one.triangles, vol.extract(Mode::Steps123).triangles);
     // The box option needs adaptive mode; entry points without it refuse the mode.
-    let p = Params {
-        max_box: Some(2),
-        ..vol.params(Mode::Embedded)
-    };
-    assert!(matches!(
-        extract(&volume, &p),
-        Err(Error::NotAdaptive { .. })
-    ));
+    for p in [
+        Params {
+            max_box: Some(2),
+            ..vol.params(Mode::Embedded)
+        },
+        Params {
+            allow_wrong_side: true,
+            ..vol.params(Mode::Steps123)
+        },
+    ] {
+        assert!(matches!(
+            extract(&volume, &p),
+            Err(Error::NotAdaptive { .. })
+        ));
+    }
     let labels = [0u8, 1, 1, 0, 0, 1, 1, 0];
     let label_params = LabelParams {
         mode: Mode::Adaptive,

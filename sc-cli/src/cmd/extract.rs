@@ -135,6 +135,11 @@ fn check_output(args: &ExtractArgs, output: &Output) -> Result<()> {
             "--max-box applies with --mode adaptive only".into(),
         ));
     }
+    if args.allow_wrong_side && args.mode != Mode::Adaptive {
+        return Err(Error::Usage(
+            "--allow-wrong-side applies with --mode adaptive only".into(),
+        ));
+    }
     if args.ascii && output.format != MeshFormat::Ply {
         return Err(Error::Usage("--ascii applies to .ply output only".into()));
     }
@@ -339,6 +344,7 @@ fn request(args: &ExtractArgs, iso: f64) -> Request {
         coordinates: args.space,
         max_error: args.error_bound(),
         max_box: args.max_box,
+        allow_wrong_side: args.allow_wrong_side,
     }
 }
 

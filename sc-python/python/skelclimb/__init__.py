@@ -280,6 +280,8 @@ def extract(
     threads=0,
     max_error=None,
     error_units="world",
+    max_box=None,
+    allow_wrong_side=False,
 ):
     """Meshes the surface ``volume == level``; samples ``>= level`` are inside.
 
@@ -310,8 +312,9 @@ def extract(
     mode : ``"embedded"`` (default), ``"paper"``, ``"steps123"`` or ``"adaptive"``
         ``embedded`` merges only where the surface stays a closed 2-manifold, ``paper`` merges
         every interior grey edge as the paper does, ``steps123`` does not merge (the Marching
-        Cubes triangle count), ``adaptive`` meshes boxes of 2³ cubes as one where they stay
-        within ``max_error`` of the Steps 1–3 surface (one thread; not for blocks or Dask).
+        Cubes triangle count), ``adaptive`` meshes boxes of up to 16³ cubes as one where they
+        stay within ``max_error`` of the Steps 1–3 surface (default: half the smallest
+        spacing; one thread; not for blocks or Dask).
     pad : bool
         Surround the volume with one layer of empty samples (a copy), so every surface is
         closed; positions stay in the unpadded volume's coordinates.
@@ -328,6 +331,13 @@ def extract(
         ``stats["bounded"]`` counts the merges the bound refused.
     error_units : ``"world"`` (default) or ``"voxels"``
         ``max_error`` in world units (index × spacing) or in grid steps.
+    max_box : int or None
+        Adaptive mode's largest box, in cubes per side: 1, 2, 4, 8 or 16 (the default), no
+        larger than the volume. Other modes refuse it.
+    allow_wrong_side : bool
+        Adaptive mode: let boxes leave samples on the wrong side of the surface, as the 1998
+        paper does, for fewer triangles. By default every sample keeps its side. Other modes
+        refuse it.
 
     Returns
     -------
@@ -363,8 +373,20 @@ def extract(
     verts, faces, norms, stats = _native.extract(
         volume, level, spacing, origin, mode, bool(normals), threads,
         _bound(max_error, error_units), None if affine is None else affine[:3].tolist(), space,
+        _max_box(max_box), bool(allow_wrong_side),
     )
     return Mesh(verts, faces, norms, stats)
+
+
+def _max_box(max_box):
+    """``max_box`` as an int for the native call (the runtime checks its range), or None."""
+    if max_box is None:
+        return None
+    if isinstance(max_box, bool) or not isinstance(max_box, (int, np.integer)):
+        raise TypeError(f"max_box: expected an int or None, got {max_box!r}")
+    if not 0 <= max_box < 2**32:
+        raise ValueError(f"max_box: must be a power of two from 1 to 16, got {max_box}")
+    return int(max_box)
 
 
 class Scan(NamedTuple):

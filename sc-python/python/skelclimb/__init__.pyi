@@ -39,6 +39,8 @@ def extract(
     threads: int = ...,
     max_error: Optional[float] = ...,
     error_units: Literal["world", "voxels"] = ...,
+    max_box: Optional[int] = ...,
+    allow_wrong_side: bool = ...,
 ) -> Mesh: ...
 def marching_cubes(
     volume: npt.NDArray[Any],

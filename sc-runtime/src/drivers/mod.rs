@@ -72,6 +72,11 @@ pub(crate) fn not_adaptive(params: &Params, entry: &'static str) -> Result<(), E
             what: "max_box needs adaptive mode",
         });
     }
+    if params.allow_wrong_side {
+        return Err(Error::NotAdaptive {
+            what: "allow_wrong_side needs adaptive mode",
+        });
+    }
     Ok(())
 }
 

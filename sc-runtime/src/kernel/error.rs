@@ -73,8 +73,8 @@ pub enum Error {
         /// The largest box allowed on this volume, in cubes.
         largest: u32,
     },
-    /// `max_box` given to a mode that makes no boxes, or adaptive mode asked of an entry point
-    /// that does not run it: `what` names it.
+    /// `max_box` or `allow_wrong_side` given to a mode that makes no boxes, or adaptive mode
+    /// asked of an entry point that does not run it: `what` names it.
     NotAdaptive {
         /// The option or entry point.
         what: &'static str,

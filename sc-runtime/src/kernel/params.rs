@@ -195,6 +195,10 @@ pub struct Params {
     /// largest this version makes (2) and the volume's longest cube count; `None` (the default)
     /// is that largest. 1 keeps every unit cube, the Steps 1–3 mesh. Other modes refuse it.
     pub max_box: Option<u32>,
+    /// Adaptive mode: let boxes leave samples on the wrong side of the surface, as the 1998
+    /// paper does, for fewer triangles; off by default, every sample keeps its side. Other modes
+    /// refuse it.
+    pub allow_wrong_side: bool,
     /// The case tables; [`crate::tables::DEFAULT`] unless a crate brings its own.
     pub tables: &'static crate::tables::CaseTables,
 }
@@ -213,6 +217,7 @@ impl Params {
             axes: Axes::Xyz,
             max_error: None,
             max_box: None,
+            allow_wrong_side: false,
             tables: &crate::tables::DEFAULT,
         }
     }

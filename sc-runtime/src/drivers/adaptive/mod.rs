@@ -20,7 +20,9 @@ use crate::drivers::has_cubes;
 use crate::kernel::Binary;
 use crate::kernel::adaptive::checks::scaled;
 use crate::kernel::adaptive::outline::Shape;
-use crate::kernel::adaptive::{BoxSource, Crossing, Metric, Vertex, accept, outline, triangulate};
+use crate::kernel::adaptive::{
+    BoxSource, Crossing, Tolerance, Vertex, accept, outline, triangulate,
+};
 use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
 use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume};
@@ -92,20 +94,21 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
         return Ok(mesh);
     }
     let bound = params.max_error.unwrap_or_else(|| default_bound(params));
-    let metric = Metric {
+    let tolerance = Tolerance {
         scale: match bound {
             ErrorBound::World(_) => params.spacing,
             ErrorBound::Voxels(_) => [1.0; 3],
         },
         limit: bound.value(),
+        allow_wrong_side: params.allow_wrong_side,
     };
     let grid = Grid::new(volume, params.iso, &rec, &mesh.triangles);
-    let lattice = grid.decide(levels, &metric);
+    let lattice = grid.decide(levels, &tolerance);
     let triangles = match lattice.first() {
         Some((pairs, _)) => {
             let mut level = final_levels(&lattice);
             balance(&mut level, *pairs, dims);
-            grid.emit(&lattice, &level, &metric)
+            grid.emit(&lattice, &level, &tolerance)
         }
         None => mesh.triangles.clone(),
     };
@@ -206,12 +209,12 @@ impl<'a, T: Scalar> Grid<'a, T> {
         &self.by_cube[lo..hi]
     }
 
-    /// The Steps 1–3 triangles of the box of `side` at `corner`, in the metric's units.
+    /// The Steps 1–3 triangles of the box of `side` at `corner`, in the tolerance's units.
     fn patch(
         &self,
         corner: [usize; 3],
         side: usize,
-        metric: &Metric,
+        tolerance: &Tolerance,
         out: &mut Vec<[[f64; 3]; 3]>,
     ) {
         out.clear();
@@ -219,7 +222,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
             for dy in 0..side {
                 for dx in 0..side {
                     let cube = [corner[0] + dx, corner[1] + dy, corner[2] + dz];
-                    self.cube_triangles(cube, &mut |t| out.push(t.map(|p| scaled(p, metric))));
+                    self.cube_triangles(cube, &mut |t| out.push(t.map(|p| scaled(p, tolerance))));
                 }
             }
         }
@@ -227,7 +230,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
 
     /// Decides the boxes of every size up to `2^levels`, smallest first: a box is tested only if
     /// its eight children may all be boxes.
-    fn decide(&self, levels: usize, metric: &Metric) -> Lattice {
+    fn decide(&self, levels: usize, tolerance: &Tolerance) -> Lattice {
         let mut lattice: Lattice = Vec::new();
         let mut patch = Vec::new();
         for level in 1..=levels {
@@ -260,8 +263,8 @@ impl<'a, T: Scalar> Grid<'a, T> {
                                 None => m,
                             }
                         });
-                        self.patch(corner, side, metric, &mut patch);
-                        if accept(self, &o, may_chord, &patch, metric) {
+                        self.patch(corner, side, tolerance, &mut patch);
+                        if accept(self, &o, may_chord, &patch, tolerance) {
                             Cell::Box
                         } else {
                             Cell::Cubes
@@ -277,7 +280,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
     /// The triangles: those of unit cubes outside boxes, in sweep order, then each box's, size
     /// by size, in the variant its neighbours give it. `level` is the balanced size of the box
     /// holding each pair of cubes (`final_levels`).
-    fn emit(&self, lattice: &Lattice, level: &[u8], metric: &Metric) -> Vec<[u32; 3]> {
+    fn emit(&self, lattice: &Lattice, level: &[u8], tolerance: &Tolerance) -> Vec<[u32; 3]> {
         let pairs = lattice[0].0;
         let in_box = |cube_key: u64| -> bool {
             let pair = unkey(cube_key as usize, self.dims).map(|c| c / 2);
@@ -311,10 +314,10 @@ impl<'a, T: Scalar> Grid<'a, T> {
                         _ => m | 1 << i,
                     }
                 });
-                self.patch(corner, side, metric, &mut patch);
+                self.patch(corner, side, tolerance, &mut patch);
                 // Accepted boxes triangulate in every variant (`accept`), and the choice
                 // depends on the box and its variant alone.
-                let Some(t) = triangulate(self, &o, refined, &patch, metric) else {
+                let Some(t) = triangulate(self, &o, refined, &patch, tolerance) else {
                     debug_assert!(false, "an accepted box failed its variant");
                     continue;
                 };

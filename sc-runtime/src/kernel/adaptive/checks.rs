@@ -6,7 +6,7 @@
 //! costs triangles.
 
 use super::outline::{Outline, on_line, others};
-use super::{BoxSource, MAX_POLYGON, Metric, Vertex};
+use super::{BoxSource, MAX_POLYGON, Tolerance, Vertex};
 use crate::geometry::point_triangle_distance_squared;
 use crate::kernel::vertex::root::sqrt;
 
@@ -320,23 +320,27 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     sqrt(e[0] * e[0] + e[1] * e[1])
 }
 
-/// A point in grid steps, in the metric's units.
+/// A point in grid steps, in the tolerance's units.
 #[inline]
-pub(crate) fn scaled(p: [f64; 3], metric: &Metric) -> [f64; 3] {
-    core::array::from_fn(|d| p[d] * metric.scale[d])
+pub(crate) fn scaled(p: [f64; 3], tolerance: &Tolerance) -> [f64; 3] {
+    core::array::from_fn(|d| p[d] * tolerance.scale[d])
 }
 
-/// (E): the box's triangles and the Steps 1–3 triangles of the box (`patch`, in the metric's
+/// (E): the box's triangles and the Steps 1–3 triangles of the box (`patch`, in the tolerance's
 /// units) lie within the bound of each other, every point of each (not only sampled ones): see
 /// [`within`].
-pub(crate) fn within_bound(tris: &[[Vertex; 3]], patch: &[[[f64; 3]; 3]], metric: &Metric) -> bool {
+pub(crate) fn within_bound(
+    tris: &[[Vertex; 3]],
+    patch: &[[[f64; 3]; 3]],
+    tolerance: &Tolerance,
+) -> bool {
     let mut ours = [[[0.0; 3]; 3]; super::MAX_TRIANGLES];
     for (i, t) in tris.iter().enumerate() {
-        ours[i] = t.map(|v| scaled(v.p, metric));
+        ours[i] = t.map(|v| scaled(v.p, tolerance));
     }
     let ours = &ours[..tris.len()];
-    ours.iter().all(|&t| within(t, patch, metric.limit))
-        && patch.iter().all(|&t| within(t, ours, metric.limit))
+    ours.iter().all(|&t| within(t, patch, tolerance.limit))
+        && patch.iter().all(|&t| within(t, ours, tolerance.limit))
 }
 
 /// Whether every point of triangle `t` lies within `limit` of one of `others`. The distance to
@@ -344,7 +348,7 @@ pub(crate) fn within_bound(tris: &[[Vertex; 3]], patch: &[[[f64; 3]; 3]], metric
 /// `l / √3` of one of its corners (the circumradius when it is acute, at most `l / 2`
 /// otherwise). So sampling `t` on a lattice of `n` steps per side and requiring each sample
 /// within `limit − l / (n√3)` bounds every point; `n` is chosen so that this slack is at most
-/// half the limit.
+/// a quarter of the limit (half would halve the work but leave most boxes at half the bound).
 pub(crate) fn within(t: [[f64; 3]; 3], others: &[[[f64; 3]; 3]], limit: f64) -> bool {
     if limit.is_nan() || limit <= 0.0 {
         return false;
@@ -353,24 +357,28 @@ pub(crate) fn within(t: [[f64; 3]; 3], others: &[[[f64; 3]; 3]], limit: f64) -> 
         |a: [f64; 3], b: [f64; 3]| (0..3).map(|d| (a[d] - b[d]) * (a[d] - b[d])).sum::<f64>();
     let longest = sqrt(len2(t[0], t[1]).max(len2(t[1], t[2])).max(len2(t[2], t[0])));
     let sqrt3 = sqrt(3.0);
-    let n = ((longest / (sqrt3 * 0.5 * limit)) as usize + 1).min(64);
+    let n = ((longest / (sqrt3 * 0.25 * limit)) as usize + 1).min(64);
     let slack = longest / (n as f64 * sqrt3);
     let reach = limit - slack;
     if reach <= 0.0 {
         return false;
     }
     let reach2 = reach * reach;
+    // Neighbouring samples are usually near the same triangle: try the last one found first.
+    let mut last = 0;
     for i in 0..=n {
         for j in 0..=n - i {
             let (s, r) = (i as f64 / n as f64, j as f64 / n as f64);
             let p: [f64; 3] = core::array::from_fn(|d| {
                 t[0][d] + s * (t[1][d] - t[0][d]) + r * (t[2][d] - t[0][d])
             });
-            if !others
-                .iter()
-                .any(|&o| point_triangle_distance_squared(p, o) <= reach2)
-            {
-                return false;
+            let near = |o: &[[f64; 3]; 3]| point_triangle_distance_squared(p, *o) <= reach2;
+            if others.get(last).is_some_and(near) {
+                continue;
+            }
+            match others.iter().position(near) {
+                Some(k) => last = k,
+                None => return false,
             }
         }
     }

@@ -83,12 +83,15 @@ impl Vertex {
     }
 }
 
-/// How a box's distances are measured: grid steps scaled per axis (the spacing, for an error
-/// bound in world units; ones for voxels), and the bound.
+/// How far a box's triangles may depart from Steps 1–3's: distances in grid steps scaled per
+/// axis (the spacing, for an error bound in world units; ones for voxels) up to `limit`, and
+/// whether samples may end up on the wrong side.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Metric {
+pub(crate) struct Tolerance {
     /// Multiplies each coordinate in grid steps.
     pub scale: [f64; 3],
     /// The largest distance allowed between the box's triangles and Steps 1–3's, both ways.
     pub limit: f64,
+    /// Whether the separation test (P) is waived, as the 1998 paper waives it.
+    pub allow_wrong_side: bool,
 }

@@ -12,7 +12,7 @@
 
 use super::checks::{faces_up, in_wall, quality, separates, simple_projection, within_bound};
 use super::outline::Outline;
-use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Metric, Vertex};
+use super::{BoxSource, MAX_CORNERS, MAX_MIDS, MAX_TRIANGLES, Tolerance, Vertex};
 
 /// A box's triangles, wound filled → empty.
 #[derive(Clone, Debug)]
@@ -143,16 +143,75 @@ fn refine(outline: &Outline, refined: u8, coarse: &[[u8; 3]]) -> Option<(Triangu
 /// The most coarse triangulations of a corner polygon: 14, of a hexagon.
 const MAX_COARSE: usize = 14;
 
+/// The triangulation of the whole polygon, midline vertices included, whose worst triangle is
+/// best shaped among those whose triangles all face up with none in a face; `None` if there is
+/// none. The coarse-then-fan candidates are some of these triangulations; this one is tried when
+/// none of them passes, as where a coarse triangle with two refined sides has no fan that
+/// faces up. By dynamic programming over the polygon's chains, `O(m³)` for `m ≤ 18` vertices;
+/// ties go to the first apex, so the result is a function of the polygon alone.
+fn best_whole(outline: &Outline, polygon: &[Vertex]) -> Option<Triangulation> {
+    const N: usize = super::MAX_POLYGON;
+    let m = polygon.len();
+    // worst[i][j]: the best worst quality of chain i..=j closed by the chord (i, j);
+    // -1 where the chain has no valid triangulation. apex[i][j]: the apex over (i, j).
+    let mut worst = [[-1.0f64; N]; N];
+    let mut apex = [[0u8; N]; N];
+    for i in 0..m - 1 {
+        worst[i][i + 1] = f64::INFINITY;
+    }
+    for gap in 2..m {
+        for i in 0..m - gap {
+            let j = i + gap;
+            for k in i + 1..j {
+                let t = [polygon[i], polygon[k], polygon[j]];
+                let w = worst[i][k].min(worst[k][j]);
+                if w < 0.0 || in_wall(&t) || !faces_up(&t, outline) {
+                    continue;
+                }
+                let w = w.min(quality(&t));
+                if w > worst[i][j] {
+                    worst[i][j] = w;
+                    apex[i][j] = k as u8;
+                }
+            }
+        }
+    }
+    if worst[0][m - 1] < 0.0 {
+        return None;
+    }
+    let mut out = Triangulation {
+        tris: [[Vertex::default(); 3]; MAX_TRIANGLES],
+        n: 0,
+    };
+    let mut chains = [(0u8, 0u8); N];
+    chains[0] = (0, m as u8 - 1);
+    let mut pending = 1;
+    while pending > 0 {
+        pending -= 1;
+        let (i, j) = chains[pending];
+        let (i, j) = (usize::from(i), usize::from(j));
+        if j - i < 2 {
+            continue;
+        }
+        let k = usize::from(apex[i][j]);
+        out.push([polygon[i], polygon[k], polygon[j]]);
+        chains[pending] = (i as u8, k as u8);
+        chains[pending + 1] = (k as u8, j as u8);
+        pending += 2;
+    }
+    Some(out)
+}
+
 /// The box's triangles in the variant `refined`, if some triangulation passes every test: of
 /// those that do, the one whose worst triangle is best shaped. Candidates are refined and
 /// ranked first, then tested best first, so (P) and (E), the costly tests, usually run once.
-/// `patch` is the box's Steps 1–3 triangles in the metric's units.
+/// `patch` is the box's Steps 1–3 triangles in the tolerance's units.
 pub(crate) fn triangulate(
     src: &impl BoxSource,
     outline: &Outline,
     refined: u8,
     patch: &[[[f64; 3]; 3]],
-    metric: &Metric,
+    tolerance: &Tolerance,
 ) -> Option<Triangulation> {
     let (polygon, m) = outline.polygon(refined);
     if !simple_projection(&polygon[..m], outline.axis) {
@@ -187,13 +246,25 @@ pub(crate) fn triangulate(
             index += 1;
         });
         let Some(t) = found else { continue };
-        if separates(src, outline, refined, t.triangles())
-            && within_bound(t.triangles(), patch, metric)
-        {
+        if passes(src, outline, refined, &t, patch, tolerance) {
             return Some(t);
         }
     }
-    None
+    best_whole(outline, &polygon[..m])
+        .filter(|t| passes(src, outline, refined, t, patch, tolerance))
+}
+
+/// (P), unless the tolerance allows wrong-side samples, and (E).
+fn passes(
+    src: &impl BoxSource,
+    outline: &Outline,
+    refined: u8,
+    t: &Triangulation,
+    patch: &[[[f64; 3]; 3]],
+    tolerance: &Tolerance,
+) -> bool {
+    (tolerance.allow_wrong_side || separates(src, outline, refined, t.triangles()))
+        && within_bound(t.triangles(), patch, tolerance)
 }
 
 /// Whether the box can be emitted in every variant its neighbours may give it: bit `i` of
@@ -203,7 +274,7 @@ pub(crate) fn accept(
     outline: &Outline,
     may_chord: u8,
     patch: &[[[f64; 3]; 3]],
-    metric: &Metric,
+    tolerance: &Tolerance,
 ) -> bool {
     let with_mids = (0..outline.n)
         .filter(|&i| outline.has_mids(i))
@@ -211,7 +282,7 @@ pub(crate) fn accept(
     let free = may_chord & with_mids;
     let mut chords = free;
     loop {
-        if triangulate(src, outline, with_mids & !chords, patch, metric).is_none() {
+        if triangulate(src, outline, with_mids & !chords, patch, tolerance).is_none() {
             return false;
         }
         if chords == 0 {
