@@ -221,7 +221,12 @@ def main():
     ap.add_argument("--step", type=float, default=0.5,
                     help="distance sampling: lattice spacing on each triangle, in grid steps")
     ap.add_argument("--out", default=HERE)
+    ap.add_argument("--from-json", metavar="FILE", help="only rewrite results.md from a results.json")
     a = ap.parse_args()
+    if a.from_json:
+        with open(os.path.join(a.out, "results.md"), "w") as f:
+            f.write(markdown(json.load(open(a.from_json))))
+        return
 
     tools = vtk.vtkSMPTools()
     tools.SetBackend("Sequential")
@@ -300,6 +305,31 @@ def upper(d):
     return f" / {d['max_upper']:.3f}" if d["max_upper"] > d["max"] + 0.005 else ""
 
 
+def summary(r):
+    """One line per volume: adaptive mode at 0.5 voxel (and with --allow-wrong-side) against
+    Flying Edges decimated by fast_simplification to the same triangle count."""
+    lines = [
+        "| volume | Steps 1–3 △ | adaptive 0.5 △ | its time ms | FE ms | FE + fs ms | max dist ours / FE + fs | wrong side ours / FE + fs | FE + fs non-manifold edges |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for v in r["volumes"]:
+        rows = {row["method"]: row for row in v["rows"]}
+        fe = rows["FE"]
+        for label in ["adaptive 0.5", "adaptive 0.5 wrong-side"]:
+            if "ours " + label not in rows:
+                continue
+            ours, fs = rows["ours " + label], rows[f"FE + fast_simplification to {label}"]
+            steps = rows["ours steps123"]["triangles"]
+            lines.append(
+                f"| {v['name']}{' (wrong side allowed)' if 'wrong' in label else ''} | {steps:,} | "
+                f"{ours['triangles']:,} ({steps / ours['triangles']:.2f}×) | {1000 * ours['seconds']:.0f} | "
+                f"{1000 * fe['seconds']:.1f} | {1000 * fs['seconds']:.0f} | "
+                f"{ours['distance']['max']:.2f} / {fs['distance']['max']:.2f} | "
+                f"{ours['sides']['wrong']} / {fs['sides']['wrong']} | {fs['edges']['nonmanifold'] + fs['edges']['border']} |"
+            )
+    return "\n".join(lines) + "\n"
+
+
 def markdown(r):
     m = r["machine"]
     lines = [
@@ -317,6 +347,7 @@ def markdown(r):
         "Wrong side: samples whose side by the mesh (ray parity) differs from `value >= iso`, "
         "all samples (within 2 samples of the surface in brackets when they differ).",
         "",
+        summary(r),
     ]
     for v in r["volumes"]:
         lines.append(f"### {v['name']} ({' × '.join(map(str, v['dims']))}{', padded' if v['padded'] else ''}, iso {v['iso']:g})")
