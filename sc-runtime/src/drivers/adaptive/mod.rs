@@ -27,6 +27,7 @@ use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
 use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume};
 
+mod merged;
 mod record;
 
 use record::Recorded;
@@ -109,16 +110,37 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
         limit: bound.value(),
         allow_wrong_side: params.allow_wrong_side,
     };
+    // Embedded mode's merges under the same bound, for the unit cubes no box covers.
+    let embedded = Params {
+        mode: Mode::Embedded,
+        max_error: Some(bound),
+        max_box: None,
+        allow_wrong_side: false,
+        normals: false,
+        values: false,
+        ..*params
+    };
+    let mut merged = Recorded::new(dims);
+    let mut scratch = OwnedScratch::new(dims)?;
+    sweep_into(
+        &Binary::new(&embedded),
+        volume,
+        &embedded,
+        scratch.lend(),
+        &mut merged,
+    )?;
+    drop(scratch);
     let grid = Grid::new(volume, params.iso, &rec, &mesh.triangles);
     let lattice = grid.decide(levels, &tolerance);
-    let triangles = match lattice.first() {
+    let (triangles, merges) = match lattice.first() {
         Some((pairs, _)) => {
             let mut level = final_levels(&lattice);
             balance(&mut level, *pairs, dims);
-            grid.emit(&lattice, &level, &tolerance)
+            grid.emit(&lattice, &level, &tolerance, &merged)
         }
-        None => mesh.triangles.clone(),
+        None => grid.emit_units(&merged, |_| false, params.allow_wrong_side),
     };
+    mesh.stats.merged = merges;
     drop(grid);
     mesh.triangles = triangles;
     compact(&mut mesh);
@@ -151,9 +173,9 @@ struct Grid<'a, T: Scalar> {
     vertex_of: Vec<(u64, u32)>,
     /// Triangle ids sorted by their cube's key, with those keys.
     by_cube: Vec<(u64, u32)>,
+    /// The Steps 1–3 triangles, and each one's cube and each vertex's edge.
     triangles: &'a [[u32; 3]],
-    edges: &'a [u64],
-    cubes: &'a [u64],
+    rec: &'a Recorded,
 }
 
 impl<'a, T: Scalar> Grid<'a, T> {
@@ -177,8 +199,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
             vertex_of,
             by_cube,
             triangles,
-            edges: &rec.edges,
-            cubes: &rec.cubes,
+            rec,
         }
     }
 
@@ -300,19 +321,19 @@ impl<'a, T: Scalar> Grid<'a, T> {
     /// The triangles: those of unit cubes outside boxes, in sweep order, then each box's, size
     /// by size, in the variant its neighbours give it. `level` is the balanced size of the box
     /// holding each pair of cubes (`final_levels`).
-    fn emit(&self, lattice: &Lattice, level: &[u8], tolerance: &Tolerance) -> Vec<[u32; 3]> {
+    fn emit(
+        &self,
+        lattice: &Lattice,
+        level: &[u8],
+        tolerance: &Tolerance,
+        merged: &Recorded,
+    ) -> (Vec<[u32; 3]>, u64) {
         let pairs = lattice[0].0;
         let in_box = |cube_key: u64| -> bool {
             let pair = unkey(cube_key as usize, self.dims).map(|c| c / 2);
             (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
-        let mut out: Vec<[u32; 3]> = self
-            .triangles
-            .iter()
-            .zip(self.cubes)
-            .filter(|&(_, &c)| c == u64::MAX || !in_box(c))
-            .map(|(&t, _)| t)
-            .collect();
+        let (mut out, merges) = self.emit_units(merged, in_box, tolerance.allow_wrong_side);
         let mut buf = PatchBuf::default();
         for (l, (cells, states)) in lattice.iter().enumerate() {
             let (l, side) = (l as u8 + 1, 2usize << l);
@@ -350,7 +371,31 @@ impl<'a, T: Scalar> Grid<'a, T> {
                 }
             }
         }
-        out
+        (out, merges)
+    }
+
+    /// The triangles of the unit cubes outside boxes, with embedded mode's merges where no box
+    /// is near ([`merged::unit_triangles`]), and the number of merges kept.
+    fn emit_units(
+        &self,
+        merged: &Recorded,
+        in_box: impl Fn(u64) -> bool,
+        allow_wrong_side: bool,
+    ) -> (Vec<[u32; 3]>, u64) {
+        let id = |key: u64| {
+            let i = self.vertex_of.partition_point(|&(k, _)| k < key);
+            self.vertex_of[i].1
+        };
+        let place = |key: u64| self.place(key);
+        merged::unit_triangles(
+            self.triangles,
+            self.rec,
+            merged,
+            id,
+            place,
+            in_box,
+            allow_wrong_side,
+        )
     }
 }
 
@@ -463,7 +508,7 @@ impl<T: Scalar> BoxSource for Grid<'_, T> {
     fn cube_triangles(&self, cube: [usize; 3], f: &mut dyn FnMut([[f64; 3]; 3])) {
         for &(_, i) in self.cube_range(self.key(cube)) {
             let t = self.triangles[i as usize];
-            f(t.map(|v| self.place(self.edges[v as usize])));
+            f(t.map(|v| self.place(self.rec.edges[v as usize])));
         }
     }
 }

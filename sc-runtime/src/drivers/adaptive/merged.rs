@@ -1,0 +1,204 @@
+//! Step 4 among the unit cubes no box covers (docs/adaptive.md, "Kept"): embedded mode's merges,
+//! kept wherever the four cubes a merge touches all stay unit cubes.
+//!
+//! A merge removes the vertex on a grey edge and replaces the four triangles around it, one in
+//! each cube around the edge, by two on the same four outer vertices; the sides on the four
+//! cubes' outer faces stay as they were. So a merge whose four cubes are outside every box can be
+//! kept as embedded mode makes it: the walls it shares with boxes are unchanged, and the boxes'
+//! tests still hold beside it. Merges are read back from the two sweeps: a removed vertex, its
+//! fan of four Steps 1–3 triangles, and the two embedded triangles on the fan's ring.
+
+use alloc::vec::Vec;
+
+use super::record::Recorded;
+
+/// A triangle as its vertices' edge keys, rotated to start at the least (the winding kept).
+fn canonical(t: [u32; 3], edges: &[u64]) -> [u64; 3] {
+    let k = t.map(|v| edges[v as usize]);
+    let i = (0..3).min_by_key(|&i| k[i]).unwrap_or(0);
+    [k[i], k[(i + 1) % 3], k[(i + 2) % 3]]
+}
+
+/// One merge read back from the sweeps: Steps 1–3's fan around the removed vertex and
+/// embedded mode's triangles on its ring.
+#[derive(Default)]
+struct Merge {
+    fan: Vec<usize>,
+    new: Vec<[u64; 3]>,
+}
+
+/// The triangles of the cubes outside boxes, as ids of the Steps 1–3 vertices: Steps 1–3's
+/// (`triangles`, recorded in `steps`), except that each merge of `merged` (embedded mode's sweep
+/// of the same volume under the same bound) whose four cubes are outside boxes replaces its fan.
+/// Returns them with the number of merges kept. `vertex_id` maps an edge key to its Steps 1–3
+/// vertex and `place` to its position in grid steps; `in_box` says whether a cube (by key) lies
+/// in a box. Unless `allow_wrong_side`, a merge is kept only if no corner of its four cubes
+/// changes side ([`keeps_sides`]): embedded mode's bound alone lets a merge pass a sample.
+pub(super) fn unit_triangles(
+    triangles: &[[u32; 3]],
+    steps: &Recorded,
+    merged: &Recorded,
+    vertex_id: impl Fn(u64) -> u32,
+    place: impl Fn(u64) -> [f64; 3],
+    in_box: impl Fn(u64) -> bool,
+    allow_wrong_side: bool,
+) -> (Vec<[u32; 3]>, u64) {
+    let sorted = |mut v: Vec<u64>| {
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let used = |tris: &[[u32; 3]], edges: &[u64]| {
+        sorted(tris.iter().flatten().map(|&v| edges[v as usize]).collect())
+    };
+    let kept_vertices = used(&merged.mesh.triangles, &merged.edges);
+    let old: Vec<u64> = used(triangles, &steps.edges)
+        .into_iter()
+        .filter(|k| kept_vertices.binary_search(k).is_err())
+        .collect();
+    let mut merges: Vec<Merge> = (0..old.len()).map(|_| Merge::default()).collect();
+    // Each ring vertex with the merges whose ring holds it.
+    let mut ring: Vec<(u64, u32)> = Vec::new();
+    for (i, &t) in triangles.iter().enumerate() {
+        let k = canonical(t, &steps.edges);
+        for (c, key) in k.iter().enumerate() {
+            if let Ok(m) = old.binary_search(key) {
+                merges[m].fan.push(i);
+                ring.extend([k[(c + 1) % 3], k[(c + 2) % 3]].map(|r| (r, m as u32)));
+            }
+        }
+    }
+    ring.sort_unstable();
+    ring.dedup();
+    let before = sorted_triangles(triangles, &steps.edges);
+    for &t in &merged.mesh.triangles {
+        let k = canonical(t, &merged.edges);
+        if before.binary_search(&k).is_ok() {
+            continue;
+        }
+        let on_ring = |m: u32| k.iter().all(|&v| ring.binary_search(&(v, m)).is_ok());
+        let from = ring.partition_point(|&(v, _)| v < k[0]);
+        if let Some(&(_, m)) = ring[from..]
+            .iter()
+            .take_while(|&&(v, _)| v == k[0])
+            .find(|&&(_, m)| on_ring(m))
+        {
+            merges[m as usize].new.push(k);
+        }
+    }
+    let mut dropped = alloc::vec![false; triangles.len()];
+    let mut out = Vec::new();
+    let mut count = 0;
+    for m in &merges {
+        let whole = m.fan.len() == 4 && m.new.len() == 2;
+        if whole
+            && m.fan.iter().all(|&i| !in_box(steps.cubes[i]))
+            && (allow_wrong_side || keeps_sides(m, triangles, steps, &place))
+        {
+            for &i in &m.fan {
+                dropped[i] = true;
+            }
+            out.extend(m.new.iter().map(|k| k.map(&vertex_id)));
+            count += 1;
+        }
+    }
+    let kept = triangles
+        .iter()
+        .zip(&steps.cubes)
+        .zip(&dropped)
+        .filter(|&((_, &c), &d)| !d && (c == u64::MAX || !in_box(c)))
+        .map(|((&t, _), _)| t);
+    let mut all: Vec<[u32; 3]> = kept.collect();
+    all.append(&mut out);
+    (all, count)
+}
+
+/// The triangles as canonical edge-key triples, sorted.
+fn sorted_triangles(triangles: &[[u32; 3]], edges: &[u64]) -> Vec<[u64; 3]> {
+    let mut v: Vec<[u64; 3]> = triangles.iter().map(|&t| canonical(t, edges)).collect();
+    v.sort_unstable();
+    v
+}
+
+/// Whether no corner of a merge's four cubes lies inside the closed surface its fan and its two
+/// triangles (reversed) make: the samples that would change side. By the parity of a ray's
+/// crossings; a ray that grazes a side or starts on the surface counts as a change, so the
+/// merge is refused (which only costs triangles).
+fn keeps_sides(
+    m: &Merge,
+    triangles: &[[u32; 3]],
+    steps: &Recorded,
+    place: impl Fn(u64) -> [f64; 3],
+) -> bool {
+    let mut shell = [[[0.0; 3]; 3]; 6];
+    for (s, &i) in m.fan.iter().enumerate() {
+        shell[s] = triangles[i].map(|v| place(steps.edges[v as usize]));
+    }
+    for (s, k) in m.new.iter().enumerate() {
+        shell[4 + s] = k.map(&place);
+    }
+    // A direction no grid line or face diagonal follows.
+    const RAY: [f64; 3] = [1.0, 0.313_7, 0.271_9];
+    for &i in &m.fan {
+        let cube = super::unkey(steps.cubes[i] as usize, steps.dims);
+        for corner in 0..8 {
+            let p: [f64; 3] = core::array::from_fn(|d| (cube[d] + (corner >> d & 1)) as f64);
+            let mut crossings = 0;
+            for t in &shell {
+                match ray_hits(p, RAY, t) {
+                    Some(true) => crossings += 1,
+                    Some(false) => {}
+                    None => return false,
+                }
+            }
+            if crossings % 2 == 1 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether the ray `p + s · d`, `s > 0`, crosses triangle `t` (Möller–Trumbore); `None` where
+/// it comes too close to a side, a corner or its own start to tell.
+fn ray_hits(p: [f64; 3], d: [f64; 3], t: &[[f64; 3]; 3]) -> Option<bool> {
+    const EPS: f64 = 1e-9;
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (e1, e2) = (sub(t[1], t[0]), sub(t[2], t[0]));
+    let h = cross(d, e2);
+    let det = dot(e1, h);
+    if det.abs() < EPS {
+        // Parallel to the plane: no crossing, unless the start lies in it.
+        let n = cross(e1, e2);
+        return (dot(n, sub(p, t[0])).abs() > EPS).then_some(false);
+    }
+    let q = sub(p, t[0]);
+    let u = dot(q, h) / det;
+    let r = cross(q, e1);
+    let v = dot(d, r) / det;
+    let s = dot(e2, r) / det;
+    let near = |x: f64| x.abs() < EPS;
+    if near(u) || near(v) || near(1.0 - u - v) {
+        let inside = u > -EPS && v > -EPS && u + v < 1.0 + EPS;
+        return if inside && s > -EPS {
+            None
+        } else {
+            Some(false)
+        };
+    }
+    if u < 0.0 || v < 0.0 || u + v > 1.0 {
+        return Some(false);
+    }
+    if near(s) {
+        return None;
+    }
+    Some(s > 0.0)
+}
