@@ -11,6 +11,8 @@
 use alloc::vec::Vec;
 
 use super::record::Recorded;
+use crate::kernel::adaptive::Tolerance;
+use crate::kernel::adaptive::checks::{scaled, within};
 
 /// A triangle as its vertices' edge keys, rotated to start at the least (the winding kept).
 fn canonical(t: [u32; 3], edges: &[u64]) -> [u64; 3] {
@@ -32,8 +34,10 @@ struct Merge {
 /// of the same volume under the same bound) whose four cubes are outside boxes replaces its fan.
 /// Returns them with the number of merges kept. `vertex_id` maps an edge key to its Steps 1–3
 /// vertex and `place` to its position in grid steps; `in_box` says whether a cube (by key) lies
-/// in a box. Unless `allow_wrong_side`, a merge is kept only if no corner of its four cubes
-/// changes side ([`keeps_sides`]): embedded mode's bound alone lets a merge pass a sample.
+/// in a box. A merge is kept only if its two triangles and its fan lie within the tolerance of
+/// each other, every point (embedded mode's bound measures the removed vertex and the new
+/// diagonal only), and, unless the tolerance allows wrong-side samples, if no corner of its
+/// four cubes changes side ([`keeps_sides`]).
 pub(super) fn unit_triangles(
     triangles: &[[u32; 3]],
     steps: &Recorded,
@@ -41,7 +45,7 @@ pub(super) fn unit_triangles(
     vertex_id: impl Fn(u64) -> u32,
     place: impl Fn(u64) -> [f64; 3],
     in_box: impl Fn(u64) -> bool,
-    allow_wrong_side: bool,
+    tolerance: &Tolerance,
 ) -> (Vec<[u32; 3]>, u64) {
     let sorted = |mut v: Vec<u64>| {
         v.sort_unstable();
@@ -93,7 +97,8 @@ pub(super) fn unit_triangles(
         let whole = m.fan.len() == 4 && m.new.len() == 2;
         if whole
             && m.fan.iter().all(|&i| !in_box(steps.cubes[i]))
-            && (allow_wrong_side || keeps_sides(m, triangles, steps, &place))
+            && within_each_other(m, triangles, steps, &place, tolerance)
+            && (tolerance.allow_wrong_side || keeps_sides(m, triangles, steps, &place))
         {
             for &i in &m.fan {
                 dropped[i] = true;
@@ -118,6 +123,25 @@ fn sorted_triangles(triangles: &[[u32; 3]], edges: &[u64]) -> Vec<[u64; 3]> {
     let mut v: Vec<[u64; 3]> = triangles.iter().map(|&t| canonical(t, edges)).collect();
     v.sort_unstable();
     v
+}
+
+/// (E) for a merge: its two triangles and its fan within the bound of each other, both ways.
+fn within_each_other(
+    m: &Merge,
+    triangles: &[[u32; 3]],
+    steps: &Recorded,
+    place: impl Fn(u64) -> [f64; 3],
+    tolerance: &Tolerance,
+) -> bool {
+    let at = |key: u64| scaled(place(key), tolerance);
+    let fan: Vec<[[f64; 3]; 3]> = m
+        .fan
+        .iter()
+        .map(|&i| triangles[i].map(|v| at(steps.edges[v as usize])))
+        .collect();
+    let new: Vec<[[f64; 3]; 3]> = m.new.iter().map(|k| k.map(at)).collect();
+    new.iter().all(|&t| within(t, &fan[..], tolerance.limit))
+        && fan.iter().all(|&t| within(t, &new[..], tolerance.limit))
 }
 
 /// Whether no corner of a merge's four cubes lies inside the closed surface its fan and its two

@@ -138,7 +138,7 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
             balance(&mut level, *pairs, dims);
             grid.emit(&lattice, &level, &tolerance, &merged)
         }
-        None => grid.emit_units(&merged, |_| false, params.allow_wrong_side),
+        None => grid.emit_units(&merged, |_| false, &tolerance),
     };
     mesh.stats.merged = merges;
     drop(grid);
@@ -333,7 +333,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
             let pair = unkey(cube_key as usize, self.dims).map(|c| c / 2);
             (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
-        let (mut out, merges) = self.emit_units(merged, in_box, tolerance.allow_wrong_side);
+        let (mut out, merges) = self.emit_units(merged, in_box, tolerance);
         let mut buf = PatchBuf::default();
         for (l, (cells, states)) in lattice.iter().enumerate() {
             let (l, side) = (l as u8 + 1, 2usize << l);
@@ -380,7 +380,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
         &self,
         merged: &Recorded,
         in_box: impl Fn(u64) -> bool,
-        allow_wrong_side: bool,
+        tolerance: &Tolerance,
     ) -> (Vec<[u32; 3]>, u64) {
         let id = |key: u64| {
             let i = self.vertex_of.partition_point(|&(k, _)| k < key);
@@ -394,7 +394,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
             id,
             place,
             in_box,
-            allow_wrong_side,
+            tolerance,
         )
     }
 }

@@ -408,14 +408,18 @@ impl Nearby for Patch<'_> {
         let mut from = [0; 3];
         let mut to = [0; 3];
         for d in 0..3 {
+            // In cubes from the box's corner: cube c spans [c, c + 1]. Casts truncate, which is
+            // the floor for the non-negative values they see (`no_std` has no `f64::floor`).
             let at = self.corner[d] as f64;
-            let first = (lo[d] / self.scale[d] - at).floor() - 1.0;
-            let last = ((hi[d] / self.scale[d] - at).floor()).min(self.side as f64 - 1.0);
-            if last < first.max(0.0) {
+            let (x, y) = (lo[d] / self.scale[d] - at, hi[d] / self.scale[d] - at);
+            if y < 0.0 {
                 return None;
             }
-            from[d] = first.max(0.0) as usize;
-            to[d] = last as usize;
+            from[d] = if x < 1.0 { 0 } else { x as usize - 1 };
+            to[d] = (y as usize).min(self.side - 1);
+            if to[d] < from[d] {
+                return None;
+            }
         }
         for z in from[2]..=to[2] {
             for y in from[1]..=to[1] {
