@@ -3,8 +3,9 @@
 use std::fmt;
 use std::time::Duration;
 
+use sc_io::distance::Distance;
 use sc_io::report;
-use sc_runtime::{ErrorBound, Mode, Stats};
+use sc_runtime::{ErrorBound, ErrorUnits, Mode, Stats};
 use serde_json::{Value, json};
 
 use crate::check::EdgeReport;
@@ -45,6 +46,11 @@ pub struct Summary {
     pub paper_knot: Option<u64>,
     /// With `--check`: how the mesh's edges are shared.
     pub edges: Option<EdgeReport>,
+    /// Adaptive mode: the sampled distance between its surface and Steps 1–3's, in the bound's
+    /// units.
+    pub distance: Option<Distance>,
+    /// Time spent measuring that distance.
+    pub measure: Option<Duration>,
 }
 
 /// A mode's name in reports.
@@ -80,6 +86,12 @@ pub fn add_counts(j: &mut Value, mode: Mode, max_error: Option<ErrorBound>, s: &
 }
 
 impl Summary {
+    /// The units distances are reported in: the bound's, world units when no bound was given
+    /// (adaptive mode's default bound is in world units).
+    fn bound_units(&self) -> ErrorUnits {
+        self.max_error.map_or(ErrorUnits::World, ErrorBound::units)
+    }
+
     /// The JSON form: same numbers, seconds as floats.
     pub fn to_json(&self) -> Value {
         let mut j = json!({
@@ -96,9 +108,20 @@ impl Summary {
                 "write": self.write.as_secs_f64(),
             },
         });
+        if let Some(t) = self.measure {
+            j["seconds"]["measure"] = t.as_secs_f64().into();
+        }
         add_counts(&mut j, self.mode, self.max_error, &self.stats);
         if let Some(e) = self.edges {
             j["edges"] = e.to_json();
+        }
+        if let Some(d) = self.distance {
+            j["distance_to_steps123"] = json!({
+                "mean": d.mean,
+                "max": d.max,
+                "samples": d.samples,
+                "units": self.bound_units().name(),
+            });
         }
         j
     }
@@ -170,6 +193,19 @@ impl fmt::Display for Summary {
                 )?;
             }
         }
+        if let Some(d) = self.distance {
+            let units = match self.bound_units() {
+                ErrorUnits::World => "world units",
+                ErrorUnits::Voxels => "voxels",
+            };
+            writeln!(
+                f,
+                "  distance to Steps 1–3: mean {:.4}, max {:.4} {units} ({} points sampled)",
+                d.mean,
+                d.max,
+                thousands(d.samples)
+            )?;
+        }
         if let Some(ours) = self.paper_knot {
             let [mc, t13, t14] = PAPER_KNOT.map(thousands);
             writeln!(
@@ -199,7 +235,11 @@ impl fmt::Display for Summary {
             self.read.as_secs_f64(),
             self.extract.as_secs_f64(),
             self.write.as_secs_f64()
-        )
+        )?;
+        if let Some(t) = self.measure {
+            write!(f, ", measure {:.3} s", t.as_secs_f64())?;
+        }
+        Ok(())
     }
 }
 
@@ -242,6 +282,8 @@ mod tests {
             write: Duration::from_millis(1),
             paper_knot: None,
             edges: None,
+            distance: None,
+            measure: None,
         };
         let text = s.to_string();
         assert!(
@@ -257,5 +299,36 @@ mod tests {
         assert!(text.contains("coordinates: RAS world"), "{text}");
         assert_eq!(j["dims"], serde_json::json!([4, 5, 6]));
         assert_eq!(j["reduction_percent"], 25.0);
+        assert!(j.get("distance_to_steps123").is_none() && !text.contains("distance"));
+
+        // Adaptive mode reports its distance to Steps 1–3 in the bound's units.
+        let adaptive = Summary {
+            mode: Mode::Adaptive,
+            max_error: Some(ErrorBound::Voxels(0.5)),
+            distance: Some(Distance {
+                mean: 0.0625,
+                max: 0.375,
+                samples: 1234,
+            }),
+            measure: Some(Duration::from_millis(3)),
+            ..s
+        };
+        let text = adaptive.to_string();
+        assert!(
+            text.contains("distance to Steps 1–3: mean 0.0625, max 0.3750 voxels (1,234 points"),
+            "{text}"
+        );
+        assert!(text.contains("measure 0.003 s"), "{text}");
+        let j = adaptive.to_json();
+        let d = &j["distance_to_steps123"];
+        assert_eq!(
+            (d["mean"].as_f64(), d["max"].as_f64()),
+            (Some(0.0625), Some(0.375))
+        );
+        assert_eq!(
+            (d["samples"].as_u64(), d["units"].as_str()),
+            (Some(1234), Some("voxels"))
+        );
+        assert_eq!(j["seconds"]["measure"], 0.003);
     }
 }

@@ -625,3 +625,52 @@ fn max_box_caps_adaptive_boxes_and_is_refused_elsewhere() {
         assert!(!out.exists(), "{args:?}");
     }
 }
+
+/// With `--stats-json`, adaptive mode reports its sampled distance to Steps 1–3 in the bound's
+/// units: within the bound, and reaching a good part of it (boxes grow until the bound stops
+/// them); the other modes report none.
+#[test]
+fn adaptive_stats_report_the_distance_to_steps123_within_the_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let stats = |args: &[&str]| {
+        let json = dir.path().join("stats.json");
+        let out = dir.path().join("torus.ply");
+        let run = Command::cargo_bin("skelclimb")
+            .unwrap()
+            .args(["extract", "--demo", "torus", "--size", "40", "-q", "-o"])
+            .arg(&out)
+            .arg("--stats-json")
+            .arg(&json)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&std::fs::read(json).unwrap()).unwrap()
+    };
+    for (bound, units) in [("0.3", "voxels"), ("0.8", "voxels"), ("0.01", "world")] {
+        let j = stats(&[
+            "--mode",
+            "adaptive",
+            "--max-error",
+            bound,
+            "--error-units",
+            units,
+        ]);
+        let d = &j["distance_to_steps123"];
+        let (mean, max) = (d["mean"].as_f64().unwrap(), d["max"].as_f64().unwrap());
+        let bound: f64 = bound.parse().unwrap();
+        assert_eq!(d["units"], units);
+        assert!(
+            0.0 < mean && mean < max && max <= bound && max > 0.25 * bound,
+            "{units}: mean {mean}, max {max}, bound {bound}"
+        );
+        assert!(d["samples"].as_u64().unwrap() > j["result"]["triangles"].as_u64().unwrap());
+        assert!(j["seconds"]["measure"].as_f64().is_some());
+    }
+    let j = stats(&["--mode", "embedded", "--max-error", "0.3"]);
+    assert!(j.get("distance_to_steps123").is_none() && j["seconds"].get("measure").is_none());
+}

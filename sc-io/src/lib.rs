@@ -31,7 +31,8 @@
 //! - [`surface`]: the extraction of a grid (whole, streamed, or as [`shard`]s).
 //! - [`write`](mod@write): a mesh out, in the format its file name asks for, through an
 //!   [`atomic`] file, whole or not at all; [`mesh_in`]: a mesh read back, for comparisons.
-//! - [`report`]: the counts of an extraction as JSON; [`progress`]: how long-running work
+//! - [`report`]: the counts of an extraction as JSON; [`distance`]: how far apart two meshes
+//!   are; [`progress`]: how long-running work
 //!   tells how far it got.
 //!
 //! The formats' parsers and writers behind these are private: a format is chosen by its file
@@ -39,6 +40,7 @@
 
 pub mod atomic;
 mod buffer;
+pub mod distance;
 mod error;
 mod input;
 pub mod labels;

@@ -1,14 +1,16 @@
 //! The bridge from a typed [`Grid`] to the generic extractor.
 
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 use sc_runtime::{
     ErrorBound, Mesh, Mode, Params, Scratch, SliceStreamer, Volume, block_samples, extract_block,
     extract_par,
 };
 
+use crate::distance::{self, Distance};
 use crate::error::Result;
-use crate::progress::Progress;
+use crate::progress::{Progress, Silent};
 use crate::read::stream::Stream;
 use crate::shard::{MANIFEST_NAME, Manifest, ShardEntry, write_shard};
 use crate::space::{Coordinates, World};
@@ -76,15 +78,57 @@ pub fn world(grid: &Grid, request: &Request) -> World {
 /// Extracts the surface of `grid` in world units: the scanner's world when the file places the
 /// volume in one (see [`crate::space`]), otherwise index × spacing + origin.
 pub fn extract(grid: &Grid, request: &Request, progress: &dyn Progress) -> Result<Mesh> {
+    Ok(extract_measured(grid, request, false, progress)?.0)
+}
+
+/// [`extract`], and in adaptive mode with `measure` also the mesh's sampled symmetric distance
+/// to the Steps 1–3 surface of the same grid, in the units of the error bound it holds (world
+/// units, or grid steps for a bound in voxels), sampled every quarter grid step: what the bound
+/// promises, measured; with the time measuring took. `None` in the other modes, whose bound is
+/// not a distance between surfaces.
+pub fn extract_measured(
+    grid: &Grid,
+    request: &Request,
+    measure: bool,
+    progress: &dyn Progress,
+) -> Result<(Mesh, Option<(Distance, Duration)>)> {
     let world = world(grid, request);
     let params = params(grid, request, &world);
     progress.phase("meshing", grid.dims[2].saturating_sub(1) as u64);
     let mut mesh =
         with_samples!(&grid.samples, v => run(v, grid.dims, &params, request.threads, progress))?;
+    let mut measured = None;
+    if measure && params.mode == Mode::Adaptive {
+        let steps123 = Params {
+            mode: Mode::Steps123,
+            normals: false,
+            max_error: None,
+            max_box: None,
+            allow_wrong_side: false,
+            ..params
+        };
+        progress.phase("measuring", 1);
+        let clock = Instant::now();
+        let reference = with_samples!(&grid.samples, v => run(v, grid.dims, &steps123, request.threads, &Silent))?;
+        // Measured before any placement, where grid steps are `spacing` apart along each axis.
+        let least = params.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+        let (scale, step) = match request.max_error {
+            Some(ErrorBound::Voxels(_)) => (params.spacing.map(|s| 1.0 / s), 0.25),
+            _ => ([1.0; 3], 0.25 * least),
+        };
+        let d = distance::symmetric(
+            (&mesh.positions, &mesh.triangles),
+            (&reference.positions, &reference.triangles),
+            scale,
+            step,
+        );
+        measured = Some((d, clock.elapsed()));
+        progress.inc(1);
+    }
     if !world.is_translation() {
         world.place(&mut mesh);
     }
-    Ok(mesh)
+    Ok((mesh, measured))
 }
 
 /// Extracts the surface of a volume read slab by slab: the same mesh as [`extract`] of the

@@ -53,11 +53,14 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let clock = Instant::now();
     let request = request(args, iso);
     let world = surface::world(volume.grid(), &request);
-    let mesh = match &mut volume {
-        Volume::Whole(grid) => surface::extract(grid, &request, &progress)?,
-        Volume::Streamed(stream) => surface::extract_stream(stream, &request, &progress)?,
+    let (mesh, distance) = match &mut volume {
+        Volume::Whole(grid) => {
+            surface::extract_measured(grid, &request, args.stats_json.is_some(), &progress)?
+        }
+        Volume::Streamed(stream) => (surface::extract_stream(stream, &request, &progress)?, None),
     };
-    let extract_time = clock.elapsed();
+    let measure_time = distance.map(|(_, t)| t);
+    let extract_time = clock.elapsed() - measure_time.unwrap_or_default();
     for warning in &volume.grid().warnings {
         warn(warning);
     }
@@ -93,6 +96,8 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         write: clock.elapsed(),
         paper_knot,
         edges: args.check.then(|| EdgeReport::of(&mesh.triangles)),
+        distance: distance.map(|(d, _)| d),
+        measure: measure_time,
     };
     super::commit_with_report(mesh_filled, stats_file, || summary.to_json())?;
     if !quiet {
