@@ -4,7 +4,7 @@
 //! volume and smoothing; the whole read's refusals hold for the stream and leave no file.
 
 mod common;
-use common::{entries, fixture, gzip};
+use common::{entries, fixture, gzip, limited};
 
 use std::path::Path;
 
@@ -265,14 +265,7 @@ fn a_volume_too_large_for_memory_says_stream_would_mesh_it() {
     )
     .unwrap();
     let before = entries(d);
-    Command::new("bash")
-        .current_dir(d)
-        .arg("-c")
-        .arg(format!(
-            "ulimit -v 6000000; exec {} extract tall.zarr --labels all -o out",
-            assert_cmd::cargo::cargo_bin("skelclimb").display()
-        ))
-        .timeout(std::time::Duration::from_secs(20))
+    limited(d, "extract tall.zarr --labels all -o out")
         .assert()
         .code(1)
         .stderr(contains("tall.zarr"))
