@@ -224,9 +224,10 @@ pub struct ExtractArgs {
     pub output: Option<PathBuf>,
     /// Mesh a label volume (a segmentation, an atlas): every region at once, each a closed
     /// mesh, neighbours sharing their interfaces exactly. `all` or a list such as `1,5,17-20`
-    /// chooses which labels get a mesh.
+    /// chooses which labels get a mesh. With --stream, the same meshes from a few slices at a
+    /// time.
     #[arg(long, value_name = "all|LIST", value_parser = sc_io::labels::Selection::parse,
-          conflicts_with_all = ["iso", "demo", "stream", "shards", "max_error", "max_box", "allow_wrong_side", "pad"])]
+          conflicts_with_all = ["iso", "demo", "shards", "max_error", "max_box", "allow_wrong_side", "pad"])]
     pub labels: Option<sc_io::labels::Selection>,
     /// With --labels: the label of no region, not meshed, and what lies outside the volume.
     #[arg(long, requires = "labels", default_value_t = 0)]
@@ -295,8 +296,9 @@ pub struct ExtractArgs {
     #[arg(long, conflicts_with = "stream")]
     pub pad: bool,
     /// Read the volume a few slices at a time instead of whole, so that a volume larger than
-    /// memory can be meshed (raw files, NIfTI and Zarr; one thread). This happens by itself for
-    /// Zarr stores, and when the samples would fill more than half the machine's memory.
+    /// memory can be meshed (raw files, NIfTI and Zarr; one thread), surfaces and --labels
+    /// alike, into the same mesh files. This happens by itself for Zarr stores, and when the
+    /// samples would fill more than half the machine's memory.
     #[arg(long, conflicts_with = "demo")]
     pub stream: bool,
     /// Where the samples are.

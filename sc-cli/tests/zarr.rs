@@ -3,7 +3,7 @@
 //! translation; levels are chosen with --zarr-level; bad stores fail cleanly.
 
 mod common;
-use common::{entries, fixture};
+use common::{entries, fixture, limited};
 
 use std::path::Path;
 use std::sync::Arc;
@@ -262,20 +262,6 @@ fn v2_store(dir: &Path, shape: &str, chunks: &str, extra: &str, chunk_bytes: usi
     )
     .unwrap();
     std::fs::write(dir.join("0.0.0"), vec![200u8; chunk_bytes]).unwrap();
-}
-
-/// `skelclimb` with `args` in `dir` under a 6 GB address-space limit: an allocation a header
-/// implies fails there rather than swapping, and an abort would show as exit 134.
-fn limited(dir: &Path, args: &str) -> Command {
-    let mut cmd = Command::new("bash");
-    cmd.current_dir(dir)
-        .arg("-c")
-        .arg(format!(
-            "ulimit -v 6000000; exec {} {args}",
-            assert_cmd::cargo::cargo_bin("skelclimb").display()
-        ))
-        .timeout(std::time::Duration::from_secs(20));
-    cmd
 }
 
 /// Headers that claim far more samples than the store holds (10⁶ on each axis, 10¹² or 2⁶³

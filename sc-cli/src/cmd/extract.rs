@@ -156,21 +156,21 @@ fn check_output(args: &ExtractArgs, output: &Output) -> Result<()> {
 }
 
 /// The volume to mesh: in memory, or open to be read a slab at a time.
-enum Volume {
+pub(super) enum Volume {
     Whole(Grid),
     /// The grid of a stream holds the placement and type, not the samples.
     Streamed(Stream),
 }
 
 impl Volume {
-    fn grid(&self) -> &Grid {
+    pub(super) fn grid(&self) -> &Grid {
         match self {
             Volume::Whole(grid) => grid,
             Volume::Streamed(stream) => &stream.grid,
         }
     }
 
-    fn grid_mut(&mut self) -> &mut Grid {
+    pub(super) fn grid_mut(&mut self) -> &mut Grid {
         match self {
             Volume::Whole(grid) => grid,
             Volume::Streamed(stream) => &mut stream.grid,
@@ -180,7 +180,7 @@ impl Volume {
 
 /// The volume, its iso value and its name for messages: streamed when [`open_stream`] says so,
 /// otherwise read whole (or built in).
-fn open(
+pub(super) fn open(
     args: &ExtractArgs,
     format: Option<Format>,
     options: &ReadOptions,

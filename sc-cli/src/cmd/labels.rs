@@ -5,14 +5,14 @@ use std::time::Instant;
 
 use serde_json::json;
 
-use super::extract::check_outputs;
+use super::extract::{Volume, check_outputs};
 use super::warn;
 use crate::cli::ExtractArgs;
 use crate::progress::Bar;
 use crate::summary::{mode_name, thousands};
 use sc_io::atomic::AtomicFile;
 use sc_io::labels::{self, LabelMeshes, LabelRequest, LabelTable};
-use sc_io::read::{self, Format};
+use sc_io::read::Format;
 use sc_io::write::{LabelFiles, LabelMesh, MeshFormat, WriteOptions, write_atlas};
 use sc_io::{Error, Result, report};
 
@@ -30,7 +30,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let Some(input) = &args.input else {
         return Err(Error::Usage("--labels needs an input volume".into()));
     };
-    Format::detect(input, &options)?;
+    let format = Format::detect(input, &options)?;
     let Some(output) = &args.output else {
         return Err(Error::Usage(
             "give -o ATLAS.glb (a node per label) or -o DIR (a file per label)".into(),
@@ -73,12 +73,9 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let progress = Bar::new(!quiet);
 
     let clock = Instant::now();
-    let mut grid = read::read(input, &options, &progress)?;
+    let (mut volume, _, _) = super::extract::open(args, Some(format), &options, &progress)?;
     let read_time = clock.elapsed();
-    for warning in &grid.warnings {
-        warn(warning);
-    }
-    args.placement.apply(&mut grid);
+    args.placement.apply(volume.grid_mut());
     let clock = Instant::now();
     let request = LabelRequest {
         background: args.background,
@@ -89,11 +86,19 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         selection: args.labels.clone().unwrap_or(labels::Selection::All),
         smoothing: args.smoothing,
     };
-    let result = labels::extract(&grid, &request, &progress).map_err(|e| match e {
+    let result = match &mut volume {
+        Volume::Whole(grid) => labels::extract(grid, &request, &progress),
+        Volume::Streamed(stream) => labels::extract_stream(stream, &request, &progress),
+    }
+    .map_err(|e| match e {
         Error::Usage(message) => Error::file(input, message),
         e => e,
     })?;
     let extract_time = clock.elapsed();
+    let grid = volume.grid();
+    for warning in &grid.warnings {
+        warn(warning);
+    }
 
     let clock = Instant::now();
     let world = sc_io::space::World::new(grid.frame, grid.origin, args.space);
@@ -110,7 +115,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             mesh: mesh.into(),
         })
         .collect();
-    let summary = summary(args, input, &grid, &result, [read_time, extract_time]);
+    let summary = summary(args, input, grid, &result, [read_time, extract_time]);
     let report = |written: std::time::Duration| {
         let mut json = summary.clone();
         json["seconds"]["write"] = json!(written.as_secs_f64());

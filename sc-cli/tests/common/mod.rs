@@ -38,3 +38,17 @@ pub fn gzip(bytes: &[u8]) -> Vec<u8> {
     e.write_all(bytes).unwrap();
     e.finish().unwrap()
 }
+
+/// `skelclimb` with `args` in `dir` under a 6 GB address-space limit: an allocation a header
+/// implies fails there rather than swapping, and an abort would show as exit 134.
+pub fn limited(dir: &Path, args: &str) -> assert_cmd::Command {
+    let mut cmd = assert_cmd::Command::new("bash");
+    cmd.current_dir(dir)
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 6000000; exec {} {args}",
+            assert_cmd::cargo::cargo_bin("skelclimb").display()
+        ))
+        .timeout(std::time::Duration::from_secs(20));
+    cmd
+}

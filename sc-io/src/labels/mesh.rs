@@ -3,7 +3,7 @@
 
 use std::ops::RangeInclusive;
 
-use sc_runtime::labels::{Label as Sample, LabelParams, extract_labels};
+use sc_runtime::labels::{Atlas, Label as Sample, LabelParams, extract_labels};
 use sc_runtime::{Mesh, Mode, Stats, Volume};
 
 use crate::error::{Error, Result};
@@ -89,16 +89,10 @@ pub fn extract(
     request: &LabelRequest,
     progress: &dyn Progress,
 ) -> Result<LabelMeshes> {
-    if !grid.scale.is_identity() {
-        return Err(Error::Usage(format!(
-            "--labels: the volume rescales its samples (slope {}, intercept {}); labels are \
-             read as stored integers, and a rescaled volume is a scan: give --iso instead",
-            grid.scale.slope, grid.scale.inter
-        )));
-    }
+    check_scale(grid)?;
     let world = World::new(grid.frame, grid.origin, request.coordinates);
     progress.phase("meshing labels", grid.dims[2].saturating_sub(1) as u64);
-    let mut out = match &grid.samples {
+    let out = match &grid.samples {
         Samples::U8(v) => typed(v, grid, request, &world),
         Samples::I8(v) => {
             let wide: Vec<i16> = v.iter().map(|&l| i16::from(l)).collect();
@@ -108,24 +102,62 @@ pub fn extract(
         Samples::I16(v) => typed(v, grid, request, &world),
         Samples::U32(v) => typed(v, grid, request, &world),
         Samples::I32(v) => typed(v, grid, request, &world),
-        Samples::F32(_) | Samples::F64(_) => Err(Error::Usage(format!(
-            "--labels: the volume holds {} samples; label volumes hold integers (give --iso to \
-             mesh a scan)",
-            grid.samples.dtype().name()
-        ))),
+        Samples::F32(_) | Samples::F64(_) => Err(not_integers(grid)),
     }?;
-    for (_, mesh) in &mut out.meshes {
-        if !world.is_translation() {
+    Ok(placed(out, &world))
+}
+
+/// Refuses a volume whose samples are rescaled: a scan, not labels.
+pub(super) fn check_scale(grid: &Grid) -> Result<()> {
+    if grid.scale.is_identity() {
+        return Ok(());
+    }
+    Err(Error::Usage(format!(
+        "--labels: the volume rescales its samples (slope {}, intercept {}); labels are read as \
+         stored integers, and a rescaled volume is a scan: give --iso instead",
+        grid.scale.slope, grid.scale.inter
+    )))
+}
+
+/// The refusal of floating-point samples as labels.
+pub(super) fn not_integers(grid: &Grid) -> Error {
+    Error::Usage(format!(
+        "--labels: the volume holds {} samples; label volumes hold integers (give --iso to mesh \
+         a scan)",
+        grid.samples.dtype().name()
+    ))
+}
+
+/// The meshes moved into the world, when the map to it is more than the translation the sweep
+/// applies.
+pub(super) fn placed(mut out: LabelMeshes, world: &World) -> LabelMeshes {
+    if !world.is_translation() {
+        for (_, mesh) in &mut out.meshes {
             world.place(mesh);
         }
     }
-    Ok(out)
+    out
 }
 
 /// [`extract`] for one sample type.
 fn typed<L>(data: &[L], grid: &Grid, request: &LabelRequest, world: &World) -> Result<LabelMeshes>
 where
     L: Sample + TryFrom<u64> + TryInto<i64>,
+{
+    let params = params(grid, request, world)?;
+    let volume = Volume::new(data, grid.dims)?;
+    let atlas = extract_labels(volume, &params)?;
+    select(atlas, params.background, request)
+}
+
+/// The sweep's parameters for `request` on `grid`, whose samples are of type `L`.
+pub(super) fn params<L>(
+    grid: &Grid,
+    request: &LabelRequest,
+    world: &World,
+) -> Result<LabelParams<L>>
+where
+    L: Sample + TryFrom<u64>,
 {
     let name = grid.samples.dtype().name();
     let background = L::try_from(request.background).map_err(|_| {
@@ -134,7 +166,7 @@ where
             request.background
         ))
     })?;
-    let params = LabelParams {
+    Ok(LabelParams {
         background,
         mode: request.mode,
         pad: true,
@@ -147,9 +179,19 @@ where
         threads: request.threads,
         smoothing: request.smoothing,
         ..LabelParams::default()
-    };
-    let volume = Volume::new(data, grid.dims)?;
-    let atlas = extract_labels(volume, &params)?;
+    })
+}
+
+/// The meshes of the labels `request` selects, cut from `atlas`; refuses a selection of labels
+/// no sample holds, negative labels, and a volume of background only.
+pub(super) fn select<L>(
+    atlas: Atlas<L>,
+    background: L,
+    request: &LabelRequest,
+) -> Result<LabelMeshes>
+where
+    L: Sample + TryInto<i64>,
+{
     let present = atlas.labels(background);
     let id = |l: L| -> Option<u64> { l.try_into().ok().and_then(|v: i64| u64::try_from(v).ok()) };
     if let Some(&negative) = present.iter().find(|&&l| id(l).is_none()) {

@@ -16,8 +16,10 @@
 
 mod mesh;
 mod parse;
+mod stream;
 
 pub use mesh::{LabelMeshes, LabelRequest, Selection, extract};
+pub use stream::extract_stream;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
