@@ -133,13 +133,11 @@ fn within_each_other(
     place: impl Fn(u64) -> [f64; 3],
     tolerance: &Tolerance,
 ) -> bool {
+    // Called for whole merges only: a fan of four, two new triangles.
     let at = |key: u64| scaled(place(key), tolerance);
-    let fan: Vec<[[f64; 3]; 3]> = m
-        .fan
-        .iter()
-        .map(|&i| triangles[i].map(|v| at(steps.edges[v as usize])))
-        .collect();
-    let new: Vec<[[f64; 3]; 3]> = m.new.iter().map(|k| k.map(at)).collect();
+    let fan: [[[f64; 3]; 3]; 4] =
+        core::array::from_fn(|s| triangles[m.fan[s]].map(|v| at(steps.edges[v as usize])));
+    let new: [[[f64; 3]; 3]; 2] = core::array::from_fn(|s| m.new[s].map(at));
     new.iter().all(|&t| within(t, &fan[..], tolerance.limit))
         && fan.iter().all(|&t| within(t, &new[..], tolerance.limit))
 }
