@@ -2,7 +2,8 @@
 # The Geometric Tools baseline for adaptive mode (docs/adaptive.md, "Baseline"): builds GTE's
 # header-only AdaptiveSkeletonClimbing3 with g++ around asc_bench.cpp, meshes centred
 # (2^N+1)^3 crops of real scans at a non-integer iso value, and puts beside it what `skelclimb`
-# gives on the same crops in steps123 and embedded mode (one thread, no normals, best of 3).
+# gives on the same crops in steps123, embedded and adaptive mode (default bound, half a voxel;
+# and with --allow-wrong-side, which GTE's method also allows), one thread, no normals, best of 3.
 #
 #   bench/gte/run.sh GTE [DATA] [SKELCLIMB]
 #
@@ -53,8 +54,8 @@ g++ -std=c++17 -O3 -DNDEBUG -I "$GTE/GTE" -o "$OUT/asc_bench" "$HERE/asc_bench.c
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(g++ --version | head -1)"
 echo "crops: $(( (1 << N) + 1 ))^3, centred, outer layer set to the crop's minimum; one thread; best of $REPEATS"
 echo
-echo "| volume | iso | GTE ASC triangles | GTE s | GTE closed / misoriented / bad vertex links | steps123 triangles | steps123 s | embedded triangles | embedded s | ours closed / misoriented |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "| volume | iso | GTE ASC triangles | GTE s | GTE closed / misoriented / bad vertex links | steps123 triangles | steps123 s | embedded triangles | embedded s | adaptive triangles | adaptive s | adaptive, wrong side allowed: triangles | s | adaptive's max distance to steps123 (voxels; both) | ours closed / misoriented (each mode) |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 
 for name in $VOLUMES; do
     json="$DATA/$name/$name.json"
@@ -92,31 +93,36 @@ PY
     side=$(( (1 << N) + 1 ))
     gte=$("$OUT/asc_bench" "$OUT/$name.crop.raw" "$dtype" "$N" "$iso" -1 "$REPEATS")
     echo "$gte" > "$OUT/$name.gte.json"
-    ours() { # mode -> best seconds and the stats file of the last run
-        local best=""
+    ours() { # run name, then extract options -> best seconds; the stats file of the last run
+        local run=$1 best=""
+        shift
         for _ in $(seq "$REPEATS"); do
             "$SKELCLIMB" extract "$OUT/$name.crop.raw" --dims "$side,$side,$side" --dtype "$dtype" \
-                --iso "$iso" --mode "$1" --threads 1 --no-normals --check -q \
-                -o "$OUT/$name.$1.ply" --stats-json "$OUT/$name.$1.json"
-            s=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["seconds"]["extract"])' "$OUT/$name.$1.json")
+                --iso "$iso" "$@" --threads 1 --no-normals --check -q \
+                -o "$OUT/$name.$run.ply" --stats-json "$OUT/$name.$run.json"
+            s=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["seconds"]["extract"])' "$OUT/$name.$run.json")
             best=$(python3 -c 'import sys; a=[float(x) for x in sys.argv[1:] if x]; print(min(a))' "$s" $best)
         done
         echo "$best"
     }
-    s123=$(ours steps123)
-    semb=$(ours embedded)
-    python3 - "$name" "$iso" "$OUT/$name.gte.json" "$OUT/$name.steps123.json" "$OUT/$name.embedded.json" "$s123" "$semb" <<'PY'
+    s123=$(ours steps123 --mode steps123)
+    semb=$(ours embedded --mode embedded)
+    sada=$(ours adaptive --mode adaptive)
+    sadw=$(ours adaptive-allowed --mode adaptive --allow-wrong-side)
+    python3 - "$name" "$iso" "$OUT/$name.gte.json" "$OUT/$name".{steps123,embedded,adaptive,adaptive-allowed}.json "$s123" "$semb" "$sada" "$sadw" <<'PY'
 import json, sys
-name, iso, g, a, b, sa, sb = sys.argv[1:]
-g, a, b = (json.load(open(p)) for p in (g, a, b))
+name, iso, g, a, b, c, d, sa, sb, sc, sd = sys.argv[1:]
+g, a, b, c, d = (json.load(open(p)) for p in (g, a, b, c, d))
 def ok(s):
     e = s["edges"]
     closed = e["border_edges"] == 0 and e["non_manifold_edges"] == 0
     return f'{"yes" if closed else "no"} / {e["misoriented_edges"]}'
 gte_ok = f'{"yes" if g["closed"] else "no"} / {g["misoriented_edges"]} / {g["bad_vertex_links"]}'
+dist = " / ".join(f'{s["distance_to_steps123"]["max"]:.3f}' for s in (c, d))
 print(f'| {name} | {iso} | {g["triangles"]:,} | {g["seconds"]:.3f} | {gte_ok} | '
       f'{a["result"]["triangles"]:,} | {float(sa):.3f} | {b["result"]["triangles"]:,} | {float(sb):.3f} | '
-      f'{ok(a)}, {ok(b)} |')
+      f'{c["result"]["triangles"]:,} | {float(sc):.3f} | {d["result"]["triangles"]:,} | {float(sd):.3f} | '
+      f'{dist} | {", ".join(ok(s) for s in (a, b, c, d))} |')
 PY
 done
 echo

@@ -6,14 +6,16 @@
 //! - every point of each mesh within the error bound of the other: sampled on a lattice of each
 //!   triangle that differs, against every triangle of the other mesh;
 //! - no sample on the wrong side: the two meshes differ by closed surfaces (each box's new patch
-//!   against its old one), and a sample changes side iff its winding number about them is ±1.
+//!   against its old one), and a sample changes side iff its winding number about them is ±1,
+//!   counted exactly by the crossings of a ray along x (solid angles where the sample lies on
+//!   the surface).
 
 use std::collections::{HashMap, HashSet};
 
 use sc_runtime::labels::{LabelParams, extract_labels};
 use sc_runtime::{Error, ErrorBound, Mesh, Mode, Params, Volume, demo, extract, extract_par};
 use sc_tests::checks::{assert_closed_manifold, assert_no_self_intersections};
-use sc_tests::geometry::{point_triangle_distance, solid_angle};
+use sc_tests::geometry::{RowWinding, point_triangle_distance, solid_angle};
 use sc_tests::volumes::{
     self, Sample, Vol, brainsmall_crop, integer_noise, itk_t1_crop, stent_crop,
 };
@@ -45,17 +47,21 @@ fn corners(positions: &[[f32; 3]], t: [u32; 3]) -> [P; 3] {
 }
 
 /// Triangles of `mesh` bucketed by the cells of side `h` their boxes, grown by `reach`, touch.
-struct Buckets<'m> {
-    mesh: &'m Mesh,
+struct Buckets {
+    tris: Vec<[P; 3]>,
     h: f64,
     cells: HashMap<[i64; 3], Vec<u32>>,
 }
 
-impl<'m> Buckets<'m> {
-    fn new(mesh: &'m Mesh, h: f64, reach: f64) -> Self {
+impl Buckets {
+    fn new(mesh: &Mesh, h: f64, reach: f64) -> Self {
         let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        for (i, &t) in mesh.triangles.iter().enumerate() {
-            let c = corners(&mesh.positions, t);
+        let tris: Vec<[P; 3]> = mesh
+            .triangles
+            .iter()
+            .map(|&t| corners(&mesh.positions, t))
+            .collect();
+        for (i, &c) in tris.iter().enumerate() {
             let lo: [i64; 3] = std::array::from_fn(|d| {
                 ((c.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min) - reach) / h).floor() as i64
             });
@@ -71,7 +77,7 @@ impl<'m> Buckets<'m> {
                 }
             }
         }
-        Buckets { mesh, h, cells }
+        Buckets { tris, h, cells }
     }
 
     /// The distance from `p` to the mesh, if some triangle is within the reach.
@@ -79,12 +85,7 @@ impl<'m> Buckets<'m> {
         let cell = p.map(|c| (c / self.h).floor() as i64);
         self.cells.get(&cell).map_or(f64::INFINITY, |ts| {
             ts.iter()
-                .map(|&i| {
-                    point_triangle_distance(
-                        p,
-                        corners(&self.mesh.positions, self.mesh.triangles[i as usize]),
-                    )
-                })
+                .map(|&i| point_triangle_distance(p, self.tris[i as usize]))
                 .fold(f64::INFINITY, f64::min)
         })
     }
@@ -98,7 +99,8 @@ fn one_way(from: &Mesh, to: &Mesh, reach: f64, n: usize) -> f64 {
         .iter()
         .map(|&t| canonical(&to.positions, t))
         .collect();
-    let buckets = Buckets::new(to, 4.0 * reach.max(0.25), reach);
+    // Cells as wide as the reach: each holds the triangles within reach of it, a few dozen.
+    let buckets = Buckets::new(to, reach.max(0.25), reach);
     let mut worst: f64 = 0.0;
     for &t in &from.triangles {
         if shared.contains(&canonical(&from.positions, t)) {
@@ -187,15 +189,43 @@ fn wrong_side<T: Sample>(vol: &Vol<T>, mesh: &Mesh, reference: &Mesh) -> usize {
             std::array::from_fn(|d| index(lo[d], d).ceil().max(0.0) as usize),
             std::array::from_fn(|d| (index(hi[d], d).floor() as usize).min(vol.dims[d] - 1)),
         );
-        for z in a[2]..=b[2] {
-            for y in a[1]..=b[1] {
-                for x in a[0]..=b[0] {
-                    let p = vol.world([x, y, z]);
-                    let w: f64 = tris.iter().map(|&i| solid_angle(p, diff[i])).sum::<f64>()
-                        / (4.0 * std::f64::consts::PI);
-                    if w.abs() > 0.5 {
-                        wrong += 1;
-                    }
+        // The piece's triangles by the rows of samples their y–z extent reaches (one row more
+        // either way: rounding of the extent only adds candidates, which the ray test sorts).
+        let mut rows: HashMap<[usize; 2], Vec<usize>> = HashMap::new();
+        for &i in tris {
+            let t = diff[i];
+            let reach = |d: usize| {
+                let (lo, hi) = t
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                        (l.min(p[d]), h.max(p[d]))
+                    });
+                let lo = (index(lo, d).floor() - 1.0).max(a[d] as f64) as usize;
+                let hi = (index(hi, d).ceil() + 1.0).min(b[d] as f64) as usize;
+                lo..=hi
+            };
+            for z in reach(2) {
+                for y in reach(1) {
+                    rows.entry([y, z]).or_default().push(i);
+                }
+            }
+        }
+        for ([y, z], near) in &rows {
+            let [_, py, pz] = vol.world([0, *y, *z]);
+            let row = RowWinding::new(py, pz, near.iter().map(|&i| &diff[i]));
+            for x in a[0]..=b[0] {
+                let p = vol.world([x, *y, *z]);
+                // On the surface (for the moved line): the solid angles decide, as a point on
+                // a triangle counts half.
+                let w = row.at(p).map_or_else(
+                    || {
+                        tris.iter().map(|&i| solid_angle(p, diff[i])).sum::<f64>()
+                            / (4.0 * std::f64::consts::PI)
+                    },
+                    f64::from,
+                );
+                if w.abs() > 0.5 {
+                    wrong += 1;
                 }
             }
         }
