@@ -14,35 +14,57 @@ use alloc::vec::Vec;
 use core::cmp::Reverse;
 use core::ops::Range;
 
-use crate::drivers::InMemory;
+use crate::drivers::{InMemory, adaptive};
 use crate::kernel::sink::Unsettled;
 use crate::kernel::{Binary, Engine, Layers};
 use crate::mesh::OwnedScratch;
-use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
+use crate::{Error, Mesh, Mode, Params, Scalar, Sink, Stats, Volume};
 
 /// The samples meshing the cubes `cubes` (lower corners, per axis) of a grid of `grid` samples
-/// reads: one sample before the block and two past its far corners, clipped to the grid. The
-/// halo may start at any index: the sweep takes parity classes from global indices.
+/// with `params` reads, clipped to the grid. The halo may start at any index: the sweep takes
+/// parity classes from global indices.
 ///
-/// Why that much: a cube's triangles depend on the Step 4 decisions of its grey edges, which read
-/// the cases of the four cubes around each edge and the pinch test's neighbours one sample out;
-/// and the cube that owns a merged pair emits its partner's ear too, so the partner one cube
-/// further along x or y counts as well. Normals' central differences stay within that reach.
+/// In every mode but adaptive, one sample before the block and two past its far corners: a
+/// cube's triangles depend on the Step 4 decisions of its grey edges, which read the cases of the
+/// four cubes around each edge and the pinch test's neighbours one sample out; and the cube that
+/// owns a merged pair emits its partner's ear too, so the partner one cube further along x or y
+/// counts as well. Normals' central differences stay within that reach.
+///
+/// In adaptive mode, the halo grows with [`Params::max_box`] `M`: `2M + 2` cubes before the
+/// block and `3M + 2` past it, rounded out to multiples of `M` (the box lattice), for the 2:1
+/// balancing of boxes reaches that far (docs/adaptive.md §8).
 ///
 /// ```
-/// use sc_runtime::block_samples;
+/// use sc_runtime::{Mode, Params, block_samples};
 ///
-/// assert_eq!(block_samples([100, 100, 100], [10..20, 0..99, 97..99]).unwrap(), [9..23, 0..100, 96..100]);
+/// let params = Params::new(0.5);
+/// assert_eq!(block_samples([100, 100, 100], [10..20, 0..99, 97..99], &params).unwrap(), [9..23, 0..100, 96..100]);
+/// let adaptive = Params { mode: Mode::Adaptive, max_box: Some(4), ..params };
+/// assert_eq!(block_samples([100, 100, 100], [20..40, 0..99, 97..99], &adaptive).unwrap(), [8..57, 0..100, 84..100]);
 /// ```
 pub fn block_samples(
     grid: [usize; 3],
     cubes: [Range<usize>; 3],
+    params: &Params,
 ) -> Result<[Range<usize>; 3], Error> {
     check_cubes(grid, &cubes)?;
+    check_mode(grid, params)?;
+    if params.mode == Mode::Adaptive {
+        return Ok(adaptive::blocks::block_samples(grid, &cubes, params));
+    }
     Ok(core::array::from_fn(|d| {
         let lo = cubes[d].start.saturating_sub(1);
         lo..(cubes[d].end + 3).min(grid[d])
     }))
+}
+
+/// Refuses adaptive mode's options where they do not hold for the grid, or outside it.
+fn check_mode(grid: [usize; 3], params: &Params) -> Result<(), Error> {
+    if params.mode == Mode::Adaptive {
+        adaptive::check(params, grid)
+    } else {
+        super::not_adaptive(params, "")
+    }
 }
 
 pub(crate) fn check_cubes(grid: [usize; 3], cubes: &[Range<usize>; 3]) -> Result<(), Error> {
@@ -106,7 +128,9 @@ pub struct BlockMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Per triangle, the key of the cube that owns it; non-decreasing.
     pub cubes: Vec<u64>,
-    /// The counts of the owned cubes and edges; they add up across blocks.
+    /// The counts of the owned cubes and edges; they add up across blocks, but for `vertices`
+    /// and `triangles`, which [`BlockMesh::into_mesh`] counts in the join (an adaptive box's
+    /// vertex may be used by a block that does not own its edge).
     pub stats: Stats,
     /// Cubes owned, so that [`BlockMesh::into_mesh`] can tell a whole grid from a partial one.
     pub covered: u64,
@@ -182,7 +206,7 @@ impl Sink for Collect {
 /// let mut joined = BlockMesh::default();
 /// for z in [0..11, 11..nz - 1] {
 ///     let cubes = [0..nx - 1, 0..ny - 1, z];
-///     let need = block_samples(v.dims, cubes.clone()).unwrap();
+///     let need = block_samples(v.dims, cubes.clone(), &params).unwrap();
 ///     let box_ = &v.data[need[2].start * nx * ny..need[2].end * nx * ny];
 ///     let dims = [nx, ny, need[2].len()];
 ///     let part = extract_block(&Volume::new(box_, dims).unwrap(), [0, 0, need[2].start], v.dims, cubes, &params).unwrap();
@@ -198,10 +222,11 @@ pub fn extract_block<T: Scalar>(
     cubes: [Range<usize>; 3],
     params: &Params,
 ) -> Result<BlockMesh, Error> {
-    super::not_adaptive(
-        params,
-        "extract_block does not run adaptive mode yet (use extract)",
-    )?;
+    if params.mode == Mode::Adaptive {
+        check_cubes(grid, &cubes)?;
+        check_mode(grid, params)?;
+        return adaptive::blocks::extract_block(samples, at, grid, cubes, params);
+    }
     sweep_block(&Binary::new(params), samples, at, grid, cubes, params)
 }
 
@@ -214,7 +239,7 @@ pub(crate) fn sweep_block<T: Scalar>(
     cubes: [Range<usize>; 3],
     params: &Params,
 ) -> Result<BlockMesh, Error> {
-    let need = block_samples(grid, cubes.clone())?;
+    let need = block_samples(grid, cubes.clone(), params)?;
     let dims = samples.dims();
     check_halo(dims, at, grid, &need)?;
     let mut out = BlockMesh {
@@ -460,10 +485,14 @@ impl BlockMesh {
             return Err(Error::TooManyVertices);
         }
         Ok(Mesh {
+            stats: Stats {
+                vertices: self.keys.len() as u64,
+                triangles: self.triangles.len() as u64,
+                ..self.stats
+            },
             positions: self.positions,
             normals: self.normals,
             triangles: self.triangles,
-            stats: self.stats,
             ..Mesh::default()
         })
     }
