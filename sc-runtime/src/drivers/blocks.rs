@@ -14,7 +14,7 @@ use alloc::vec::Vec;
 use core::cmp::Reverse;
 use core::ops::Range;
 
-use crate::drivers::{InMemory, adaptive};
+use crate::drivers::{InMemory, adaptive, keep_used};
 use crate::kernel::sink::Unsettled;
 use crate::kernel::{Binary, Engine, Layers};
 use crate::mesh::OwnedScratch;
@@ -222,34 +222,33 @@ pub fn extract_block<T: Scalar>(
     cubes: [Range<usize>; 3],
     params: &Params,
 ) -> Result<BlockMesh, Error> {
-    if params.mode == Mode::Adaptive {
-        check_cubes(grid, &cubes)?;
-        check_mode(grid, params)?;
-        return adaptive::blocks::extract_block(samples, at, grid, cubes, params);
-    }
-    sweep_block(&Binary::new(params), samples, at, grid, cubes, params)
-}
-
-/// [`extract_block`] with any engine.
-pub(crate) fn sweep_block<T: Scalar>(
-    engine: &impl Engine<T>,
-    samples: &Volume<'_, T>,
-    at: [usize; 3],
-    grid: [usize; 3],
-    cubes: [Range<usize>; 3],
-    params: &Params,
-) -> Result<BlockMesh, Error> {
     let need = block_samples(grid, cubes.clone(), params)?;
-    let dims = samples.dims();
-    check_halo(dims, at, grid, &need)?;
-    let mut out = BlockMesh {
+    check_halo(samples.dims(), at, grid, &need)?;
+    let share = BlockMesh {
         grid,
         covered: cubes.iter().map(|r| r.len() as u64).product(),
         ..BlockMesh::default()
     };
-    if out.covered == 0 {
-        return Ok(out);
+    if share.covered == 0 {
+        return Ok(share);
     }
+    if params.mode == Mode::Adaptive {
+        return adaptive::blocks::extract_block(samples, at, need, cubes, params, share);
+    }
+    sweep_block(&Binary::new(params), samples, at, cubes, params, share)
+}
+
+/// [`extract_block`] with any engine, once the samples are known to cover the halo and `out`
+/// (the share, empty) to own some cube.
+pub(crate) fn sweep_block<T: Scalar>(
+    engine: &impl Engine<T>,
+    samples: &Volume<'_, T>,
+    at: [usize; 3],
+    cubes: [Range<usize>; 3],
+    params: &Params,
+    mut out: BlockMesh,
+) -> Result<BlockMesh, Error> {
+    let (dims, grid) = (samples.dims(), out.grid);
     let mut collect = Collect {
         grid,
         keys: Vec::new(),
@@ -272,29 +271,13 @@ pub(crate) fn sweep_block<T: Scalar>(
     }
     out.stats = sweep.stats();
     // Keep the vertices the owned triangles use; the halo's others belong to other blocks.
-    let mut new_id = alloc::vec![u32::MAX; collect.keys.len()];
-    for t in &collect.triangles {
-        for &v in t {
-            new_id[v as usize] = 0;
-        }
+    out.triangles = collect.triangles;
+    let kept = keep_used(collect.keys.len(), &mut out.triangles);
+    out.keys = kept.iter().map(|&v| collect.keys[v]).collect();
+    out.positions = kept.iter().map(|&v| collect.positions[v]).collect();
+    if !collect.normals.is_empty() {
+        out.normals = kept.iter().map(|&v| collect.normals[v]).collect();
     }
-    let mut next = 0;
-    for (v, id) in new_id.iter_mut().enumerate() {
-        if *id == 0 {
-            *id = next;
-            next += 1;
-            out.keys.push(collect.keys[v]);
-            out.positions.push(collect.positions[v]);
-            if let Some(&n) = collect.normals.get(v) {
-                out.normals.push(n);
-            }
-        }
-    }
-    out.triangles = collect
-        .triangles
-        .iter()
-        .map(|t| t.map(|v| new_id[v as usize]))
-        .collect();
     out.cubes = collect.cubes;
     Ok(out)
 }

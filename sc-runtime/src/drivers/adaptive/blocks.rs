@@ -11,7 +11,8 @@ use alloc::vec::Vec;
 use core::ops::Range;
 
 use super::{LARGEST_BOX, run, unkey};
-use crate::drivers::blocks::{BlockMesh, check_halo, edge_key};
+use crate::drivers::blocks::{BlockMesh, edge_key};
+use crate::drivers::keep_used;
 use crate::{Error, Params, Scalar, Stats, Volume};
 
 /// Cubes before and past a block's own whose decisions its triangles read, before rounding
@@ -52,24 +53,17 @@ pub(crate) fn block_samples(
     })
 }
 
-/// [`crate::extract_block`] in adaptive mode; `cubes` lie in the grid and `params` were checked.
+/// [`crate::extract_block`] in adaptive mode, once `samples` (from global index `at`) are known
+/// to cover `need` ([`block_samples`]) and `out` (the share, empty) to own some cube.
 pub(crate) fn extract_block<T: Scalar>(
     samples: &Volume<'_, T>,
     at: [usize; 3],
-    grid: [usize; 3],
+    need: [Range<usize>; 3],
     cubes: [Range<usize>; 3],
     params: &Params,
+    mut out: BlockMesh,
 ) -> Result<BlockMesh, Error> {
-    let need = block_samples(grid, &cubes, params);
-    check_halo(samples.dims(), at, grid, &need)?;
-    let mut out = BlockMesh {
-        grid,
-        covered: cubes.iter().map(|r| r.len() as u64).product(),
-        ..BlockMesh::default()
-    };
-    if out.covered == 0 {
-        return Ok(out);
-    }
+    let grid = out.grid;
     // Exactly the samples `need`, which start on the lattice of every box size.
     let dims = need.clone().map(|r| r.len());
     let start = need.clone().map(|r| r.start);
@@ -105,34 +99,25 @@ pub(crate) fn extract_block<T: Scalar>(
         })
     };
     let rec = &run.rec;
-    let mut new_id = alloc::vec![u32::MAX; rec.edges.len()];
     for (&owner, t) in run.owners.iter().zip(&run.triangles) {
         if owned(owner) {
             // Owners are keyed as blocks key cubes (x fastest, then y, then z).
             out.cubes.push(owner);
             out.triangles.push(*t);
-            for &v in t {
-                new_id[v as usize] = 0;
-            }
         }
     }
     // Kept in sweep order, which is edge-key order.
-    let mut next = 0;
-    for (v, id) in new_id.iter_mut().enumerate() {
-        if *id == 0 {
-            *id = next;
-            next += 1;
+    let kept = keep_used(rec.edges.len(), &mut out.triangles);
+    out.keys = kept
+        .iter()
+        .map(|&v| {
             let key = rec.edges[v];
-            let lower = unkey((key / 3) as usize, grid);
-            out.keys.push(edge_key(grid, lower, (key % 3) as usize));
-            out.positions.push(rec.mesh.positions[v]);
-            if let Some(&n) = rec.mesh.normals.get(v) {
-                out.normals.push(n);
-            }
-        }
-    }
-    for t in &mut out.triangles {
-        *t = t.map(|v| new_id[v as usize]);
+            edge_key(grid, unkey((key / 3) as usize, grid), (key % 3) as usize)
+        })
+        .collect();
+    out.positions = kept.iter().map(|&v| rec.mesh.positions[v]).collect();
+    if !rec.mesh.normals.is_empty() {
+        out.normals = kept.iter().map(|&v| rec.mesh.normals[v]).collect();
     }
     let count = |keys: &[u64], owned: &dyn Fn(u64) -> bool| {
         keys.iter().filter(|&&k| owned(k)).count() as u64

@@ -18,7 +18,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::drivers::borrowed::sweep_at;
-use crate::drivers::has_cubes;
+use crate::drivers::{has_cubes, keep_used};
 use crate::kernel::Binary;
 use crate::kernel::adaptive::checks::{Memo, scaled};
 use crate::kernel::adaptive::outline::Shape;
@@ -612,36 +612,15 @@ fn neighbour(cell: [usize; 3], face: usize, cells: [usize; 3]) -> Option<usize> 
 
 /// Drops the vertices no triangle uses, keeping the others' order.
 fn compact(mesh: &mut Mesh) {
-    let n = mesh.positions.len();
-    let mut new_id = vec![u32::MAX; n];
-    for t in &mesh.triangles {
-        for &v in t {
-            new_id[v as usize] = 0;
-        }
-    }
-    let mut next = 0u32;
-    for id in new_id.iter_mut() {
-        if *id == 0 {
-            *id = next;
-            next += 1;
-        }
-    }
-    keep_column(&mut mesh.positions, &new_id);
-    keep_column(&mut mesh.normals, &new_id);
-    keep_column(&mut mesh.values, &new_id);
-    for t in &mut mesh.triangles {
-        *t = t.map(|v| new_id[v as usize]);
-    }
+    let kept = keep_used(mesh.positions.len(), &mut mesh.triangles);
+    keep_column(&mut mesh.positions, &kept);
+    keep_column(&mut mesh.normals, &kept);
+    keep_column(&mut mesh.values, &kept);
 }
 
-/// Keeps the entries of a per-vertex column (empty when not asked for) whose vertex stays.
-fn keep_column<C>(column: &mut Vec<C>, new_id: &[u32]) {
-    if column.is_empty() {
-        return;
+/// Keeps the entries `kept` of a per-vertex column (empty when not asked for).
+fn keep_column<C: Copy>(column: &mut Vec<C>, kept: &[usize]) {
+    if !column.is_empty() {
+        *column = kept.iter().map(|&v| column[v]).collect();
     }
-    let mut i = 0;
-    column.retain(|_| {
-        i += 1;
-        new_id[i - 1] != u32::MAX
-    });
 }
