@@ -29,12 +29,14 @@ fn read(dir: &Path, name: &str) -> Vec<u8> {
 fn knot_shards_merge_into_the_whole_mesh() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let cases: [(&str, &[&str], &str); 5] = [
+    let cases: [(&str, &[&str], &str); 7] = [
         ("embedded", &[], "7"),
         ("paper", &[], "13"),
         ("steps123", &[], "5"),
         ("embedded", &["--no-normals"], "3"),
         ("embedded", &["--max-error", "0.1"], "16"),
+        ("adaptive", &["--max-box", "4"], "13"),
+        ("adaptive", &["--allow-wrong-side", "--pad"], "20"),
     ];
     for (mode, extra, block) in cases {
         let knot = ["extract", "--demo", "knot", "--size", "34", "--mode", mode];
@@ -176,7 +178,7 @@ fn random_shards(dir: &Path, samples: &[u8], dims: [usize; 3], params: &Params, 
         for y in &ys {
             for x in &xs {
                 let cubes = [x.clone(), y.clone(), z.clone()];
-                let need = block_samples(dims, cubes.clone()).unwrap();
+                let need = block_samples(dims, cubes.clone(), params).unwrap();
                 let mut part = vec![];
                 for k in need[2].clone() {
                     for j in need[1].clone() {

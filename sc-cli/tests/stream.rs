@@ -140,5 +140,18 @@ fn streaming_failures_are_clean() {
         ])
         .assert()
         .code(2);
+    // Adaptive mode's halo is far more than the stream's slices: refused by name, and why.
+    std::fs::write(d.join("n.nii"), nifti()).unwrap();
+    skelclimb()
+        .current_dir(d)
+        .args([
+            "extract", "n.nii", "--iso", "20.5", "--stream", "-o", "m.ply",
+        ])
+        .args(["--mode", "adaptive"])
+        .assert()
+        .code(2)
+        .stderr(contains(
+            "--stream does not run --mode adaptive: the balancing",
+        ));
     assert!(!d.join("m.ply").exists());
 }

@@ -192,7 +192,7 @@ fn block_of<T: Sample>(
     cubes: [core::ops::Range<usize>; 3],
     params: &Params,
 ) -> Result<sc_runtime::BlockMesh> {
-    let need = block_samples(dims, cubes.clone())?;
+    let need = block_samples(dims, cubes.clone(), params)?;
     let [nx, ny, _] = dims;
     let mut samples = Vec::with_capacity(need.iter().map(|r| r.len()).product());
     for z in need[2].clone() {

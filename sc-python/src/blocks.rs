@@ -6,7 +6,7 @@ use numpy::{Element, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArra
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use sc_runtime::{BlockMesh, Scalar, Stats, Volume, extract_block as block};
+use sc_runtime::{BlockMesh, Params, Scalar, Stats, Volume, extract_block as block};
 
 use crate::convert::{self, with_element};
 use crate::errors;
@@ -25,10 +25,31 @@ type Share<'py> = (
     u64,
 );
 
+/// `sc_runtime::block_samples`: the samples meshing the cubes `cubes` (`(start, end)` per axis,
+/// x, y, z) of a grid of `grid` samples reads in `mode` (with boxes up to `max_box` cubes, in
+/// adaptive mode), as `(start, end)` per axis.
+#[pyfunction]
+#[pyo3(signature = (grid, cubes, mode, max_box=None))]
+pub fn block_samples(
+    grid: [usize; 3],
+    cubes: [(usize, usize); 3],
+    mode: &str,
+    max_box: Option<u32>,
+) -> PyResult<[(usize, usize); 3]> {
+    let params = Params {
+        mode: crate::extract::mode(mode)?,
+        max_box,
+        ..Params::new(0.0)
+    };
+    let need = sc_runtime::block_samples(grid, cubes.map(|(a, b)| a..b), &params)
+        .map_err(errors::runtime)?;
+    Ok(need.map(|r| (r.start, r.end)))
+}
+
 /// Meshes the cubes `cubes` (`(start, end)` per axis, x, y, z) of a grid of `grid` samples from
 /// `samples`, a 3-D array whose first sample sits at global index `at`.
 #[pyfunction]
-#[pyo3(signature = (samples, at, grid, cubes, level, spacing, origin, mode, normals, max_error=None))]
+#[pyo3(signature = (samples, at, grid, cubes, level, spacing, origin, mode, normals, max_error=None, max_box=None, allow_wrong_side=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn extract_block<'py>(
     py: Python<'py>,
@@ -42,8 +63,14 @@ pub fn extract_block<'py>(
     mode: &str,
     normals: bool,
     max_error: Option<(f64, String)>,
+    max_box: Option<u32>,
+    allow_wrong_side: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let params = params(level, spacing, origin, mode, normals, max_error)?;
+    let params = Params {
+        max_box,
+        allow_wrong_side,
+        ..params(level, spacing, origin, mode, normals, max_error)?
+    };
     let dims = convert::dims(samples, "samples")?;
     let cubes = cubes.map(|(a, b)| a..b);
     let share = with_element!(py, samples, "samples", T => run::<T>(py, samples, dims, at, grid, cubes.clone(), &params))?;
@@ -57,7 +84,7 @@ fn run<T: Scalar + Element>(
     at: [usize; 3],
     grid: [usize; 3],
     cubes: [core::ops::Range<usize>; 3],
-    params: &sc_runtime::Params,
+    params: &Params,
 ) -> PyResult<BlockMesh> {
     let data = convert::samples::<T>(samples, "samples")?;
     let data = data

@@ -35,6 +35,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(skimage::skimage_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(files::save, m)?)?;
     m.add_function(wrap_pyfunction!(files::load, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::block_samples, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::extract_block, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::merge_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::finish_blocks, m)?)?;

@@ -113,6 +113,37 @@ def test_dask_threads_with_uneven_chunks(normals):
     same(got, skelclimb.extract(v, 12, normals=normals))
 
 
+@pytest.mark.parametrize("max_box, wrong_side", [(2, False), (4, True), (None, False)])
+def test_adaptive_shares_joined_in_any_order_equal_extract(max_box, wrong_side):
+    rng = random.Random(5)
+    v = blobs((30, 27, 25), 4)
+    grid = v.shape[::-1]
+    options = dict(mode="adaptive", max_box=max_box, allow_wrong_side=wrong_side, max_error=1,
+                   error_units="voxels", spacing=(0.5, 1, 2))
+    whole = skelclimb.extract(v, 12, **options)
+    assert len(whole.faces) < skelclimb.extract(v, 12, mode="steps123").stats["steps123"]["triangles"]
+    parts = []
+    for cz in cut(grid[2], rng):
+        for cx in cut(grid[0], rng):
+            cubes = (cx, (0, grid[1] - 1), cz)
+            (x0, x1), (y0, y1), (z0, z1) = skelclimb.block_samples(
+                grid, cubes, mode="adaptive", max_box=max_box)
+            parts.append(skelclimb.extract_block(
+                v[z0:z1, y0:y1, x0:x1], 12, at=(x0, y0, z0), grid=grid, cubes=cubes, **options))
+    rng.shuffle(parts)
+    same(parts[0].merge(*parts[1:]).to_mesh(), whole)
+
+
+@pytest.mark.parametrize("max_box, wrong_side", [(2, True), (4, False)])
+def test_dask_adaptive_equals_extract(max_box, wrong_side):
+    v = blobs((40, 37, 33), 3)
+    arr = da.from_array(v, chunks=((7, 1, 20, 12), (16, 16, 5), (2, 31)))
+    options = dict(mode="adaptive", max_box=max_box, allow_wrong_side=wrong_side)
+    with dask.config.set(scheduler="threads"):
+        got = skelclimb.dask.extract(arr, 12, split_every=3, **options)
+    same(got, skelclimb.extract(v, 12, **options))
+
+
 def test_dask_checks_its_arguments():
     arr = da.zeros((4, 4), chunks=2)
     with pytest.raises(ValueError, match="3 dimensions"):

@@ -13,7 +13,9 @@
 use std::collections::{HashMap, HashSet};
 
 use sc_runtime::labels::{LabelParams, extract_labels};
-use sc_runtime::{Error, ErrorBound, Mesh, Mode, Params, Volume, demo, extract, extract_par};
+use sc_runtime::{
+    Error, ErrorBound, Mesh, Mode, Params, Volume, block_samples, demo, extract, extract_par,
+};
 use sc_tests::checks::{assert_closed_manifold, assert_no_self_intersections};
 use sc_tests::geometry::{RowWinding, point_triangle_distance, solid_angle};
 use sc_tests::volumes::{
@@ -476,9 +478,25 @@ fn bad_options_are_refused() {
         extract_labels(Volume::new(&labels, [2, 2, 2]).unwrap(), &label_params),
         Err(Error::NotAdaptive { .. })
     ));
+    // Blocks check the box against the whole grid, and refuse it without adaptive mode.
     let cubes = [0..15, 0..15, 0..15];
+    let wide = Params {
+        max_box: Some(16),
+        ..base
+    };
+    let too_wide = Error::MaxBox {
+        given: 16,
+        largest: 8,
+    };
+    let block = sc_runtime::extract_block(&volume, [0; 3], vol.dims, cubes.clone(), &wide);
+    assert_eq!(block, Err(too_wide.clone()));
+    assert_eq!(block_samples(vol.dims, cubes.clone(), &wide), Err(too_wide));
+    let boxed = Params {
+        max_box: Some(2),
+        ..vol.params(Mode::Embedded)
+    };
     assert!(matches!(
-        sc_runtime::extract_block(&volume, [0; 3], vol.dims, cubes, &base),
+        block_samples(vol.dims, cubes, &boxed),
         Err(Error::NotAdaptive { .. })
     ));
 }

@@ -7,7 +7,8 @@ use std::ops::Range;
 
 use proptest::prelude::*;
 use sc_runtime::{
-    BlockMesh, Error, Mesh, Mode, Params, Volume, block_samples, demo, extract, extract_block,
+    BlockMesh, Error, ErrorBound, Mesh, Mode, Params, Volume, block_samples, demo, extract,
+    extract_block,
 };
 use sc_tests::volumes::{
     self, Sample, Vol, blocks_between, brainsmall_crop, integer_noise, itk_t1_crop, splitmix,
@@ -16,7 +17,7 @@ use sc_tests::volumes::{
 
 /// One block's share, meshed from exactly the samples `block_samples` asks for.
 fn share<T: Sample>(vol: &Vol<T>, params: &Params, cubes: [Range<usize>; 3]) -> BlockMesh {
-    let need = block_samples(vol.dims, cubes.clone()).expect("cubes inside the grid");
+    let need = block_samples(vol.dims, cubes.clone(), params).expect("cubes inside the grid");
     let data = sub_box(&vol.data, vol.dims, &need);
     let dims = need.clone().map(|r| r.len());
     let samples = Volume::new(&data, dims).expect("box");
@@ -165,8 +166,13 @@ proptest! {
 fn a_halo_one_sample_short_is_refused() {
     let vol = volumes::demo(demo::knot(24));
     let params = vol.params(Mode::Embedded);
-    for cubes in [[5..12, 4..9, 7..15], [6..12, 5..9, 8..15]] {
-        let need = block_samples(vol.dims, cubes.clone()).expect("inside");
+    let blocks = [[5..12, 4..9, 7..15], [6..12, 5..9, 8..15]];
+    for (params, cubes) in [params]
+        .into_iter()
+        .chain([2, 4].map(|m| adaptive(&vol, m, 0.5, false)))
+        .flat_map(|p| blocks.clone().map(|c| (p, c)))
+    {
+        let need = block_samples(vol.dims, cubes.clone(), &params).expect("inside");
         for axis in 0..3 {
             for far in [false, true] {
                 let mut r = need.clone();
@@ -193,7 +199,7 @@ fn a_halo_one_sample_short_is_refused() {
     }
     // Cubes outside the grid.
     assert!(matches!(
-        block_samples([10, 10, 10], [0..10, 0..9, 0..9]),
+        block_samples([10, 10, 10], [0..10, 0..9, 0..9], &params),
         Err(Error::BlockOutsideGrid { axis: 0, .. })
     ));
 }
@@ -255,5 +261,112 @@ fn check_refuses_broken_shares() {
         let err = b.check().unwrap_err();
         assert!(matches!(err, Error::BlockMalformed { .. }), "{err}");
         assert!(err.to_string().contains(needle), "{needle}: {err}");
+    }
+}
+
+/// Adaptive mode with boxes up to `max_box` cubes, a bound of `bound` voxels and, if asked,
+/// samples allowed on the wrong side.
+fn adaptive<T: Sample>(vol: &Vol<T>, max_box: u32, bound: f64, wrong_side: bool) -> Params {
+    Params {
+        max_box: Some(max_box),
+        max_error: Some(ErrorBound::Voxels(bound)),
+        allow_wrong_side: wrong_side,
+        ..vol.params(Mode::Adaptive)
+    }
+}
+
+/// Joins the shares of every cut in `cuts`, in an order drawn from the cut's index, and checks
+/// each against the whole grid's adaptive mesh. Returns that mesh's stats.
+fn adaptive_agrees<T: Sample>(
+    vol: &Vol<T>,
+    params: &Params,
+    cuts: &[[Vec<usize>; 3]],
+    what: &str,
+) -> sc_runtime::Stats {
+    let whole = extract(&Volume::new(&vol.data, vol.dims).expect("v"), params).expect("x");
+    for (i, c) in cuts.iter().enumerate() {
+        let got = joined(vol, params, c, 7 + i as u64);
+        assert_same(&got, &whole, &format!("{what} cut at {c:?}"));
+        assert_eq!(got, whole, "{what} cut at {c:?}");
+    }
+    whole.stats
+}
+
+/// Adaptive mode's shares join into `extract`'s adaptive mesh exactly: boxes of every size up to
+/// 2, 4 and 16 cubes, (P) kept and waived, volumes whose surface is closed and one it leaves
+/// through the border (padded and not), cut into slabs one cube thick, at multiples of the box
+/// lattice and off it. The meshes have boxes (fewer triangles than Steps 1–3) and merges among
+/// unit cubes, so every kind of owner is exercised.
+#[test]
+fn adaptive_blocks_join_exactly() {
+    let mut merges = 0;
+    let torus = volumes::demo(demo::torus(32));
+    let thin_and_aligned = [vec![], vec![16], vec![15, 16, 17]];
+    let off = [vec![7], vec![20], vec![11]];
+    for (max_box, bound, wrong_side) in [(16, 1.0, false), (16, 1.0, true), (4, 0.5, false)] {
+        let params = adaptive(&torus, max_box, bound, wrong_side);
+        let what = format!("torus 32, max_box {max_box}, bound {bound}, wrong side {wrong_side}");
+        let cuts = [thin_and_aligned.clone(), off.clone()];
+        let stats = adaptive_agrees(&torus, &params, &cuts, &what);
+        assert!(stats.triangles < stats.t13, "{what}: no box");
+        merges += stats.merged;
+    }
+    // Slabs one cube thick with boxes of two cubes: every cut position, at both parities.
+    let knot = volumes::demo(demo::knot(20));
+    let params = adaptive(&knot, 2, 0.5, false);
+    let every: Vec<usize> = (1..knot.dims[2] - 1).collect();
+    let cuts = [[vec![], vec![], every], [vec![9], vec![10], vec![]]];
+    let stats = adaptive_agrees(&knot, &params, &cuts, "knot 20");
+    assert!(stats.triangles < stats.t13, "knot 20: no box");
+    merges += stats.merged;
+    // A surface through the grid's border, padded and not.
+    let noise = volumes::demo(demo::sphere_noise(24));
+    for vol in [noise.clone(), noise.padded(f64::MIN)] {
+        let params = adaptive(&vol, 4, 0.5, false);
+        let last = vol.dims[0] - 2;
+        let cuts = [
+            [vec![], vec![5], vec![4, 13]],
+            [vec![last], vec![1], vec![8]],
+        ];
+        let what = format!("noise {:?}", vol.dims);
+        let stats = adaptive_agrees(&vol, &params, &cuts, &what);
+        assert!(stats.triangles < stats.t13, "{what}: no box");
+        merges += stats.merged;
+    }
+    // Where boxes of four and eight cubes are balanced across a cut: a block needs more than
+    // the halo of the other modes here (with it, these joins differ).
+    for (vol, max_box, bound) in [
+        (volumes::demo(demo::torus(48)), 4, 0.5),
+        (volumes::demo(demo::knot(48)), 8, 1.0),
+    ] {
+        let params = adaptive(&vol, max_box, bound, false);
+        let what = format!("{:?} max_box {max_box}", vol.dims);
+        let cuts = [[vec![5], vec![], vec![21]], [vec![], vec![13], vec![17]]];
+        merges += adaptive_agrees(&vol, &params, &cuts, &what).merged;
+    }
+    assert!(merges > 0, "no merge among unit cubes");
+}
+
+/// Random cuts, up to two along each axis, on noisy spheres and every box size, the shares
+/// joined in random order and tree shape.
+#[test]
+fn adaptive_blocks_at_random_cuts_join_exactly() {
+    let vol = volumes::demo(demo::sphere_noise(32));
+    let cubes = vol.dims.map(|n| n - 1);
+    for seed in 0..6u64 {
+        let mut s = splitmix(seed);
+        let cuts = cubes.map(|n| {
+            s = splitmix(s);
+            let mut c: Vec<usize> = (0..s % 3)
+                .map(|k| 1 + (splitmix(s + k) as usize) % (n - 1))
+                .collect();
+            c.sort_unstable();
+            c.dedup();
+            c
+        });
+        let max_box = 1 << (seed % 5);
+        let params = adaptive(&vol, max_box, 0.5, seed % 2 == 1);
+        let what = format!("noise 32, max_box {max_box}, seed {seed}");
+        adaptive_agrees(&vol, &params, &[cuts], &what);
     }
 }

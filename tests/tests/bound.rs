@@ -173,7 +173,7 @@ fn threads_and_blocks_keep_the_bounded_mesh() {
         (17..nx - 1, 20..nz - 1),
     ] {
         let cubes = [x, 0..ny - 1, z];
-        let need = block_samples(vol.dims, cubes.clone()).expect("inside");
+        let need = block_samples(vol.dims, cubes.clone(), &params).expect("inside");
         let mut data = vec![];
         for z in need[2].clone() {
             for y in need[1].clone() {

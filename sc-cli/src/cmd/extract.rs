@@ -28,6 +28,14 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     if args.labels.is_some() {
         return super::labels::run(args, quiet);
     }
+    if args.stream && args.mode == Mode::Adaptive {
+        return Err(Error::Usage(
+            "--stream does not run --mode adaptive: the balancing of its boxes reads up to \
+             4 × --max-box + 2 slices past a slab (66 with boxes of 16), where the stream holds \
+             four; mesh the volume whole, or split it with --shards"
+                .into(),
+        ));
+    }
     let format = check_input(args, &options)?;
     let output = match (&args.output, &args.shards) {
         (_, Some(dir)) => return shards(args, dir, &options, quiet),

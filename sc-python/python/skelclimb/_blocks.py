@@ -15,22 +15,31 @@ from . import _native
 __all__ = ["BlockMesh", "block_samples", "extract_block"]
 
 
-def block_samples(grid, cubes):
-    """The samples a block reads: one before it and two past its far corners, clipped.
+def block_samples(grid, cubes, *, mode="embedded", max_box=None):
+    """The samples a block reads, clipped to the grid.
 
     ``grid`` is the whole grid's ``(nx, ny, nz)``; ``cubes`` gives ``(start, end)`` per axis,
     ``x, y, z``, of the cubes (by lower corner, ``0 .. n - 1``) the block owns. Returns
-    ``(start, end)`` sample ranges per axis.
+    ``(start, end)`` sample ranges per axis. In every mode but ``"adaptive"``, one sample
+    before the block and two past its far corners; in adaptive mode, a halo that grows with
+    ``max_box`` (``2 * max_box + 2`` cubes before the block and ``3 * max_box + 2`` past it,
+    rounded out to multiples of ``max_box``), for the balancing of boxes reaches that far.
 
     >>> block_samples((100, 100, 100), ((10, 20), (0, 99), (97, 99)))
     ((9, 23), (0, 100), (96, 100))
+    >>> block_samples((100, 100, 100), ((20, 40), (0, 99), (97, 99)), mode="adaptive", max_box=4)
+    ((8, 57), (0, 100), (84, 100))
     """
-    out = []
-    for n, (a, b) in zip(grid, cubes):
-        if not 0 <= a <= b <= n - 1:
-            raise ValueError(f"cubes: ({a}, {b}) is not inside 0 .. {n - 1}")
-        out.append((max(a - 1, 0), min(b + 3, n)))
-    return tuple(out)
+    from . import _index, _max_box, _mode
+
+    _mode(mode)
+    grid = tuple(_index(n, "grid") for n in grid)
+    cubes = tuple((_index(a, "cubes"), _index(b, "cubes")) for a, b in cubes)
+    if len(grid) != 3 or len(cubes) != 3:
+        raise ValueError("grid and cubes: expected three entries each (x, y, z)")
+    if min(grid + sum(cubes, ())) < 0:
+        raise ValueError(f"grid and cubes: must not be negative, got {grid}, {cubes}")
+    return tuple(_native.block_samples(grid, cubes, mode, _max_box(max_box)))
 
 
 class BlockMesh:
@@ -79,13 +88,14 @@ class BlockMesh:
 
 
 def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=(0, 0, 0),
-                  mode="embedded", normals=True, max_error=None, error_units="world"):
+                  mode="embedded", normals=True, max_error=None, error_units="world",
+                  max_box=None, allow_wrong_side=False):
     """Meshes the cubes ``cubes`` of a grid of ``grid`` samples from the samples around them.
 
     ``samples`` is a 3-D array laid out as for :func:`skelclimb.extract` (C order
     ``(z, y, x)``), holding the samples from global index ``at`` (``x, y, z``); it must cover
-    :func:`block_samples` ``(grid, cubes)``. The other arguments are :func:`skelclimb.extract`'s
-    and must be the same for every block of a grid.
+    :func:`block_samples` ``(grid, cubes, mode=mode, max_box=max_box)``. The other arguments are
+    :func:`skelclimb.extract`'s and must be the same for every block of a grid.
 
     >>> import numpy as np, skelclimb
     >>> v = np.zeros((10, 10, 10), np.uint8); v[2:8, 2:8, 2:8] = 1
@@ -99,7 +109,7 @@ def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=
     >>> bool((joined.vertices == whole.vertices).all() and (joined.faces == whole.faces).all())
     True
     """
-    from . import _MODES, _bound, _index, _level, _triple, _volume
+    from . import _MODES, _bound, _index, _level, _max_box, _triple, _volume
 
     samples = _volume(samples, "samples")
     level = _level(level)
@@ -114,6 +124,7 @@ def extract_block(samples, level, *, at, grid, cubes, spacing=(1, 1, 1), origin=
         raise ValueError(f"at, grid and cubes: must not be negative, got {at}, {grid}, {cubes}")
     share = _native.extract_block(
         samples, at, grid, cubes, level, _triple(spacing, "spacing"), _triple(origin, "origin"),
-        mode, bool(normals), _bound(max_error, error_units),
+        mode, bool(normals), _bound(max_error, error_units), _max_box(max_box),
+        bool(allow_wrong_side),
     )
     return BlockMesh(share, mode, level, bool(normals))

@@ -1,6 +1,7 @@
 """Meshing a ``dask.array`` one task per block, on whatever Dask scheduler is active.
 
-Each task reads its chunk plus a thin halo (one sample before, three after), meshes it with
+Each task reads its chunk plus a halo (one sample before, three after; in adaptive mode up to
+``3 * max_box + 1`` before and ``4 * max_box + 2`` after), meshes it with
 :func:`skelclimb.extract_block`, and returns a compact share keyed by global grid edges; a tree
 of merges joins the shares into exactly the mesh :func:`skelclimb.extract` makes of the whole
 array, whatever the chunking, the scheduler (threads, processes, a ``distributed`` cluster) or
@@ -28,8 +29,19 @@ from ._blocks import extract_block
 
 __all__ = ["extract", "labels"]
 
-# Samples before and past a chunk's sides that its cubes read (see skelclimb.block_samples).
-_BEFORE, _AFTER = 1, 3
+
+def _halo(mode, max_box):
+    """Samples before and past a chunk's sides that its cubes read, the most wherever the chunk
+    starts: from what the runtime says one-cube blocks in the middle of a large grid read
+    (:func:`skelclimb.block_samples`). Adaptive mode's halo is rounded out to the lattice of
+    its largest box (at most 16 cubes), so sixteen starts in a row meet every rounding."""
+    from ._blocks import block_samples
+
+    before = after = 0
+    for s in range(512, 528):
+        need = block_samples((1024,) * 3, ((s, s + 1),) * 3, mode=mode, max_box=max_box)[0]
+        before, after = max(before, s - need[0]), max(after, need[1] - (s + 1))
+    return before, after
 
 
 # A neighbour's place relative to a block, per axis (z, y, x): -1 before it, +1 after it.
@@ -135,8 +147,8 @@ def _at_least(chunks, m):
 
 
 def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded",
-            normals=True, max_error=None, error_units="world", split_every=8, shards=None,
-            compute=True):
+            normals=True, max_error=None, error_units="world", max_box=None,
+            allow_wrong_side=False, split_every=8, shards=None, compute=True):
     """Meshes the surface ``array == level`` of a 3-D ``dask.array``, block by block.
 
     Parameters
@@ -145,8 +157,11 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
         A NumPy array is wrapped with ``dask.array.from_array`` (automatic chunks). Axes ``(z, y, x)`` as for a C-ordered array in :func:`skelclimb.extract` (so
         ``dask.array.from_zarr`` of a ZYX store works as it is). One task per chunk; chunks of
         64³–256³ samples balance task overhead against memory per task.
-    level, spacing, origin, mode, normals, max_error, error_units
-        As for :func:`skelclimb.extract`; spacing and origin are ``(x, y, z)``.
+    level, spacing, origin, mode, normals, max_error, error_units, max_box, allow_wrong_side
+        As for :func:`skelclimb.extract`; spacing and origin are ``(x, y, z)``. In adaptive
+        mode a chunk reads a wider halo (up to 49 samples before it and 66 past it with boxes
+        of 16 cubes, see :func:`skelclimb.block_samples`), and chunks smaller than that are
+        joined to their neighbours.
     split_every : int
         How many shares each merge task joins (the fan-in of the reduction tree).
     shards : str or os.PathLike, optional
@@ -194,14 +209,16 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     if min(grid) < 2:
         raise ValueError(f"array: every axis needs at least 2 samples, got shape {array.shape}")
     _bound(max_error, error_units)
+    before, after = _halo(mode, max_box)
     options = dict(level=level, spacing=spacing, origin=origin, mode=mode, normals=normals,
-                   max_error=max_error, error_units=error_units)
+                   max_error=max_error, error_units=error_units, max_box=max_box,
+                   allow_wrong_side=bool(allow_wrong_side))
     directory = None if shards is None else os.fspath(shards)
     if directory is not None:
         os.makedirs(directory, exist_ok=True)
     token = tokenize(array.name, options, split_every, directory)
     array, name, blocks, shares = _blocks(
-        array, token, _BEFORE, _AFTER, False,
+        array, token, before, after, False,
         lambda *task: (_mesh, *task, options) if directory is None
         else (_shard, directory, *task, options))
     return _run(array, name, blocks, shares, token, split_every, compute, _merge, _finish,

@@ -14,35 +14,57 @@ use alloc::vec::Vec;
 use core::cmp::Reverse;
 use core::ops::Range;
 
-use crate::drivers::InMemory;
+use crate::drivers::{InMemory, adaptive, keep_used};
 use crate::kernel::sink::Unsettled;
 use crate::kernel::{Binary, Engine, Layers};
 use crate::mesh::OwnedScratch;
-use crate::{Error, Mesh, Params, Scalar, Sink, Stats, Volume};
+use crate::{Error, Mesh, Mode, Params, Scalar, Sink, Stats, Volume};
 
 /// The samples meshing the cubes `cubes` (lower corners, per axis) of a grid of `grid` samples
-/// reads: one sample before the block and two past its far corners, clipped to the grid. The
-/// halo may start at any index: the sweep takes parity classes from global indices.
+/// with `params` reads, clipped to the grid. The halo may start at any index: the sweep takes
+/// parity classes from global indices.
 ///
-/// Why that much: a cube's triangles depend on the Step 4 decisions of its grey edges, which read
-/// the cases of the four cubes around each edge and the pinch test's neighbours one sample out;
-/// and the cube that owns a merged pair emits its partner's ear too, so the partner one cube
-/// further along x or y counts as well. Normals' central differences stay within that reach.
+/// In every mode but adaptive, one sample before the block and two past its far corners: a
+/// cube's triangles depend on the Step 4 decisions of its grey edges, which read the cases of the
+/// four cubes around each edge and the pinch test's neighbours one sample out; and the cube that
+/// owns a merged pair emits its partner's ear too, so the partner one cube further along x or y
+/// counts as well. Normals' central differences stay within that reach.
+///
+/// In adaptive mode, the halo grows with [`Params::max_box`] `M`: `2M + 2` cubes before the
+/// block and `3M + 2` past it, rounded out to multiples of `M` (the box lattice), for the 2:1
+/// balancing of boxes reaches that far (docs/adaptive.md §8).
 ///
 /// ```
-/// use sc_runtime::block_samples;
+/// use sc_runtime::{Mode, Params, block_samples};
 ///
-/// assert_eq!(block_samples([100, 100, 100], [10..20, 0..99, 97..99]).unwrap(), [9..23, 0..100, 96..100]);
+/// let params = Params::new(0.5);
+/// assert_eq!(block_samples([100, 100, 100], [10..20, 0..99, 97..99], &params).unwrap(), [9..23, 0..100, 96..100]);
+/// let adaptive = Params { mode: Mode::Adaptive, max_box: Some(4), ..params };
+/// assert_eq!(block_samples([100, 100, 100], [20..40, 0..99, 97..99], &adaptive).unwrap(), [8..57, 0..100, 84..100]);
 /// ```
 pub fn block_samples(
     grid: [usize; 3],
     cubes: [Range<usize>; 3],
+    params: &Params,
 ) -> Result<[Range<usize>; 3], Error> {
     check_cubes(grid, &cubes)?;
+    check_mode(grid, params)?;
+    if params.mode == Mode::Adaptive {
+        return Ok(adaptive::blocks::block_samples(grid, &cubes, params));
+    }
     Ok(core::array::from_fn(|d| {
         let lo = cubes[d].start.saturating_sub(1);
         lo..(cubes[d].end + 3).min(grid[d])
     }))
+}
+
+/// Refuses adaptive mode's options where they do not hold for the grid, or outside it.
+fn check_mode(grid: [usize; 3], params: &Params) -> Result<(), Error> {
+    if params.mode == Mode::Adaptive {
+        adaptive::check(params, grid)
+    } else {
+        super::not_adaptive(params, "")
+    }
 }
 
 pub(crate) fn check_cubes(grid: [usize; 3], cubes: &[Range<usize>; 3]) -> Result<(), Error> {
@@ -106,7 +128,9 @@ pub struct BlockMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Per triangle, the key of the cube that owns it; non-decreasing.
     pub cubes: Vec<u64>,
-    /// The counts of the owned cubes and edges; they add up across blocks.
+    /// The counts of the owned cubes and edges; they add up across blocks, but for `vertices`
+    /// and `triangles`, which [`BlockMesh::into_mesh`] counts in the join (an adaptive box's
+    /// vertex may be used by a block that does not own its edge).
     pub stats: Stats,
     /// Cubes owned, so that [`BlockMesh::into_mesh`] can tell a whole grid from a partial one.
     pub covered: u64,
@@ -182,7 +206,7 @@ impl Sink for Collect {
 /// let mut joined = BlockMesh::default();
 /// for z in [0..11, 11..nz - 1] {
 ///     let cubes = [0..nx - 1, 0..ny - 1, z];
-///     let need = block_samples(v.dims, cubes.clone()).unwrap();
+///     let need = block_samples(v.dims, cubes.clone(), &params).unwrap();
 ///     let box_ = &v.data[need[2].start * nx * ny..need[2].end * nx * ny];
 ///     let dims = [nx, ny, need[2].len()];
 ///     let part = extract_block(&Volume::new(box_, dims).unwrap(), [0, 0, need[2].start], v.dims, cubes, &params).unwrap();
@@ -198,33 +222,33 @@ pub fn extract_block<T: Scalar>(
     cubes: [Range<usize>; 3],
     params: &Params,
 ) -> Result<BlockMesh, Error> {
-    super::not_adaptive(
-        params,
-        "extract_block does not run adaptive mode yet (use extract)",
-    )?;
-    sweep_block(&Binary::new(params), samples, at, grid, cubes, params)
-}
-
-/// [`extract_block`] with any engine.
-pub(crate) fn sweep_block<T: Scalar>(
-    engine: &impl Engine<T>,
-    samples: &Volume<'_, T>,
-    at: [usize; 3],
-    grid: [usize; 3],
-    cubes: [Range<usize>; 3],
-    params: &Params,
-) -> Result<BlockMesh, Error> {
-    let need = block_samples(grid, cubes.clone())?;
-    let dims = samples.dims();
-    check_halo(dims, at, grid, &need)?;
-    let mut out = BlockMesh {
+    let need = block_samples(grid, cubes.clone(), params)?;
+    check_halo(samples.dims(), at, grid, &need)?;
+    let share = BlockMesh {
         grid,
         covered: cubes.iter().map(|r| r.len() as u64).product(),
         ..BlockMesh::default()
     };
-    if out.covered == 0 {
-        return Ok(out);
+    if share.covered == 0 {
+        return Ok(share);
     }
+    if params.mode == Mode::Adaptive {
+        return adaptive::blocks::extract_block(samples, at, need, cubes, params, share);
+    }
+    sweep_block(&Binary::new(params), samples, at, cubes, params, share)
+}
+
+/// [`extract_block`] with any engine, once the samples are known to cover the halo and `out`
+/// (the share, empty) to own some cube.
+pub(crate) fn sweep_block<T: Scalar>(
+    engine: &impl Engine<T>,
+    samples: &Volume<'_, T>,
+    at: [usize; 3],
+    cubes: [Range<usize>; 3],
+    params: &Params,
+    mut out: BlockMesh,
+) -> Result<BlockMesh, Error> {
+    let (dims, grid) = (samples.dims(), out.grid);
     let mut collect = Collect {
         grid,
         keys: Vec::new(),
@@ -247,29 +271,13 @@ pub(crate) fn sweep_block<T: Scalar>(
     }
     out.stats = sweep.stats();
     // Keep the vertices the owned triangles use; the halo's others belong to other blocks.
-    let mut new_id = alloc::vec![u32::MAX; collect.keys.len()];
-    for t in &collect.triangles {
-        for &v in t {
-            new_id[v as usize] = 0;
-        }
+    out.triangles = collect.triangles;
+    let kept = keep_used(collect.keys.len(), &mut out.triangles);
+    out.keys = kept.iter().map(|&v| collect.keys[v]).collect();
+    out.positions = kept.iter().map(|&v| collect.positions[v]).collect();
+    if !collect.normals.is_empty() {
+        out.normals = kept.iter().map(|&v| collect.normals[v]).collect();
     }
-    let mut next = 0;
-    for (v, id) in new_id.iter_mut().enumerate() {
-        if *id == 0 {
-            *id = next;
-            next += 1;
-            out.keys.push(collect.keys[v]);
-            out.positions.push(collect.positions[v]);
-            if let Some(&n) = collect.normals.get(v) {
-                out.normals.push(n);
-            }
-        }
-    }
-    out.triangles = collect
-        .triangles
-        .iter()
-        .map(|t| t.map(|v| new_id[v as usize]))
-        .collect();
     out.cubes = collect.cubes;
     Ok(out)
 }
@@ -460,10 +468,14 @@ impl BlockMesh {
             return Err(Error::TooManyVertices);
         }
         Ok(Mesh {
+            stats: Stats {
+                vertices: self.keys.len() as u64,
+                triangles: self.triangles.len() as u64,
+                ..self.stats
+            },
             positions: self.positions,
             normals: self.normals,
             triangles: self.triangles,
-            stats: self.stats,
             ..Mesh::default()
         })
     }

@@ -45,12 +45,32 @@ pub(crate) fn sweep_into<T: Scalar>(
     scratch: Scratch<'_>,
     sink: &mut impl Sink,
 ) -> Result<Stats, Error> {
+    sweep_at(engine, volume, [0; 3], params, scratch, sink)
+}
+
+/// [`sweep_into`] on samples lying at global index `at` of a larger grid: every cube is meshed,
+/// but the sink is told global indices and positions, and Step 4's parity classes follow them.
+pub(crate) fn sweep_at<T: Scalar>(
+    engine: &impl Engine<T>,
+    volume: &Volume<'_, T>,
+    at: [usize; 3],
+    params: &Params,
+    scratch: Scratch<'_>,
+    sink: &mut impl Sink,
+) -> Result<Stats, Error> {
     let dims = volume.dims();
     if !has_cubes(dims) {
         return Ok(Stats::default());
     }
     let src = InMemory::new(volume);
     let mut sweep = engine.sweep(dims, params, scratch);
+    // Blocks (which allocate) are the only samples not at the grid's origin.
+    #[cfg(feature = "alloc")]
+    if at != [0; 3] {
+        sweep.restrict(at, dims.map(|n| (0, n - 1)));
+    }
+    #[cfg(not(feature = "alloc"))]
+    let _ = at;
     sweep.start(0, &src, sink, true)?;
     for k in 0..dims[2] - 1 {
         sweep.layer(k, &src, sink)?;

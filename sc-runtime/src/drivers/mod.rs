@@ -84,3 +84,26 @@ pub(crate) fn not_adaptive(params: &Params, entry: &'static str) -> Result<(), E
 pub(crate) fn has_cubes(dims: [usize; 3]) -> bool {
     dims.iter().all(|&d| d >= 2)
 }
+
+/// Renumbers `triangles` onto the vertices they use, of `count`, keeping those vertices' order;
+/// returns each kept vertex's old index, for the per-vertex columns to follow.
+#[cfg(feature = "alloc")]
+pub(crate) fn keep_used(count: usize, triangles: &mut [[u32; 3]]) -> alloc::vec::Vec<usize> {
+    let mut new_id = alloc::vec![u32::MAX; count];
+    for t in triangles.iter() {
+        for &v in t {
+            new_id[v as usize] = 0;
+        }
+    }
+    let mut kept = alloc::vec::Vec::new();
+    for (v, id) in new_id.iter_mut().enumerate() {
+        if *id == 0 {
+            *id = kept.len() as u32;
+            kept.push(v);
+        }
+    }
+    for t in triangles {
+        *t = t.map(|v| new_id[v as usize]);
+    }
+    kept
+}

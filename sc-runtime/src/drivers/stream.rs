@@ -56,7 +56,7 @@ impl<'s, T: Scalar, S: Sink> SliceStreamer<'s, T, S> {
     ) -> Result<Self, Error> {
         super::not_adaptive(
             params,
-            "SliceStreamer does not run adaptive mode: its boxes read the whole Steps 1–3 mesh (use extract)",
+            "SliceStreamer does not run adaptive mode: the balancing of its boxes reads up to 4 × max_box + 2 slices past a slab, where the stream holds four (use extract or extract_block)",
         )?;
         Scratch::len(dims)?;
         if ring.len() < Self::ring_len(dims) {

@@ -29,10 +29,17 @@ struct Merge {
     new: Vec<[u64; 3]>,
 }
 
+/// Triangles with the key of the cube that owns each, and the owner of each merge kept.
+pub(super) struct Units {
+    pub triangles: Vec<(u64, [u32; 3])>,
+    pub merges: Vec<u64>,
+}
+
 /// The triangles of the cubes outside boxes, as ids of the Steps 1–3 vertices: Steps 1–3's
 /// (`triangles`, recorded in `steps`), except that each merge of `merged` (embedded mode's sweep
 /// of the same volume under the same bound) whose four cubes are outside boxes replaces its fan.
-/// Returns them with the number of merges kept. `vertex_id` maps an edge key to its Steps 1–3
+/// A unit cube owns its own triangles; a merge's two belong to the least of its four cubes, one
+/// a merge always reads, so the owner is found wherever the merge is. `vertex_id` maps an edge key to its Steps 1–3
 /// vertex and `place` to its position in grid steps; `in_box` says whether a cube (by key) lies
 /// in a box. A merge is kept only if its two triangles and its fan lie within the tolerance of
 /// each other, every point (embedded mode's bound measures the removed vertex and the new
@@ -46,7 +53,7 @@ pub(super) fn unit_triangles(
     place: impl Fn(u64) -> [f64; 3],
     in_box: impl Fn(u64) -> bool,
     tolerance: &Tolerance,
-) -> (Vec<[u32; 3]>, u64) {
+) -> Units {
     let sorted = |mut v: Vec<u64>| {
         v.sort_unstable();
         v.dedup();
@@ -92,7 +99,7 @@ pub(super) fn unit_triangles(
     }
     let mut dropped = alloc::vec![false; triangles.len()];
     let mut out = Vec::new();
-    let mut count = 0;
+    let mut kept = Vec::new();
     for m in &merges {
         let whole = m.fan.len() == 4 && m.new.len() == 2;
         if whole
@@ -103,19 +110,28 @@ pub(super) fn unit_triangles(
             for &i in &m.fan {
                 dropped[i] = true;
             }
-            out.extend(m.new.iter().map(|k| k.map(&vertex_id)));
-            count += 1;
+            let owner = m
+                .fan
+                .iter()
+                .map(|&i| steps.cubes[i])
+                .min()
+                .unwrap_or(u64::MAX);
+            out.extend(m.new.iter().map(|k| (owner, k.map(&vertex_id))));
+            kept.push(owner);
         }
     }
-    let kept = triangles
+    let units = triangles
         .iter()
         .zip(&steps.cubes)
         .zip(&dropped)
-        .filter(|&((_, &c), &d)| !d && (c == u64::MAX || !in_box(c)))
-        .map(|((&t, _), _)| t);
-    let mut all: Vec<[u32; 3]> = kept.collect();
+        .filter(|&((_, &c), &d)| !d && !in_box(c))
+        .map(|((&t, &c), _)| (c, t));
+    let mut all: Vec<(u64, [u32; 3])> = units.collect();
     all.append(&mut out);
-    (all, count)
+    Units {
+        triangles: all,
+        merges: kept,
+    }
 }
 
 /// The triangles as canonical edge-key triples, sorted.

@@ -11,12 +11,14 @@
 //! 4. The unit cubes outside boxes keep their Steps 1–3 triangles; each box emits its
 //!    triangles in the variant its neighbours do give it, and the vertices no triangle uses any
 //!    more are dropped.
+//! 5. Triangles are ordered by the cube that owns them, so that blocks ([`blocks`]) join into
+//!    exactly this mesh.
 
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::drivers::borrowed::sweep_into;
-use crate::drivers::has_cubes;
+use crate::drivers::borrowed::sweep_at;
+use crate::drivers::{has_cubes, keep_used};
 use crate::kernel::Binary;
 use crate::kernel::adaptive::checks::{Memo, scaled};
 use crate::kernel::adaptive::outline::Shape;
@@ -27,9 +29,11 @@ use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
 use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume};
 
+pub(crate) mod blocks;
 mod merged;
 mod record;
 
+use merged::Units;
 use record::Recorded;
 
 /// The bound adaptive mode holds when none is given: half the smallest spacing, in world units
@@ -72,34 +76,73 @@ struct PatchBuf {
 pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
     let dims = volume.dims();
     check(params, dims)?;
+    let run = run(volume, [0; 3], dims, params)?;
+    let mut mesh = run.rec.mesh;
+    mesh.triangles = run.triangles;
+    compact(&mut mesh);
+    mesh.stats = Stats {
+        v13: run.rec.edges.len() as u64,
+        t13: run.rec.cubes.len() as u64,
+        merged: run.merges.len() as u64,
+        vertices: mesh.positions.len() as u64,
+        triangles: mesh.triangles.len() as u64,
+        ..Stats::default()
+    };
+    Ok(mesh)
+}
+
+/// What [`run`] makes: the Steps 1–3 sweep (global edge and cube keys), the triangles over its
+/// vertices with the cube that owns each, and the owner of each merge kept.
+struct Run {
+    rec: Recorded,
+    /// The triangles, ordered by owner and, within one, as the steps make them.
+    triangles: Vec<[u32; 3]>,
+    /// Per triangle, the key of its owner ([`Recorded::point_key`]): a unit cube's triangles
+    /// are its own, a merge's belong to the least of its four cubes and a box's to its lower
+    /// corner cube.
+    owners: Vec<u64>,
+    /// Per merge kept, its owner.
+    merges: Vec<u64>,
+}
+
+/// The adaptive mesh of samples lying at global index `at` (a multiple of the largest box) of
+/// a grid of `grid` samples, meshed as if they were the whole grid, but on the whole grid's box
+/// lattice and with its names. Where the samples reach far enough around a cube
+/// (`blocks::block_samples`), its triangles are those the whole grid gives it.
+fn run<T: Scalar>(
+    volume: &Volume<'_, T>,
+    at: [usize; 3],
+    grid: [usize; 3],
+    params: &Params,
+) -> Result<Run, Error> {
+    let dims = volume.dims();
     let steps123 = Params {
         mode: Mode::Steps123,
         max_error: None,
         max_box: None,
         ..*params
     };
-    let mut rec = Recorded::new(dims);
+    let mut rec = Recorded::new(grid);
     let mut scratch = OwnedScratch::new(dims)?;
-    let stats = sweep_into(
+    sweep_at(
         &Binary::new(&steps123),
         volume,
+        at,
         &steps123,
         scratch.lend(),
         &mut rec,
     )?;
     drop(scratch);
-    let mut mesh = core::mem::take(&mut rec.mesh);
-    mesh.stats = Stats {
-        v13: stats.v13,
-        t13: stats.t13,
-        ..Stats::default()
-    };
     let largest = params.max_box.unwrap_or(LARGEST_BOX);
     let levels = largest.ilog2() as usize;
     if !has_cubes(dims) || levels == 0 {
-        mesh.stats.vertices = mesh.positions.len() as u64;
-        mesh.stats.triangles = mesh.triangles.len() as u64;
-        return Ok(mesh);
+        // Unit cubes only: the Steps 1–3 mesh, each triangle its cube's.
+        return Ok(Run {
+            triangles: rec.mesh.triangles.clone(),
+            owners: rec.cubes.clone(),
+            merges: Vec::new(),
+            rec,
+        });
     }
     let bound = params.max_error.unwrap_or_else(|| default_bound(params));
     let tolerance = Tolerance {
@@ -120,19 +163,20 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
         values: false,
         ..*params
     };
-    let mut merged = Recorded::new(dims);
+    let mut merged = Recorded::new(grid);
     let mut scratch = OwnedScratch::new(dims)?;
-    sweep_into(
+    sweep_at(
         &Binary::new(&embedded),
         volume,
+        at,
         &embedded,
         scratch.lend(),
         &mut merged,
     )?;
     drop(scratch);
-    let grid = Grid::new(volume, params.iso, &rec, &mesh.triangles);
+    let grid = Grid::new(volume, at, grid, params.iso, &rec);
     let lattice = grid.decide(levels, &tolerance);
-    let (triangles, merges) = match lattice.first() {
+    let units = match lattice.first() {
         Some((pairs, _)) => {
             let mut level = final_levels(&lattice);
             balance(&mut level, *pairs, dims);
@@ -140,13 +184,20 @@ pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Res
         }
         None => grid.emit_units(&merged, |_| false, &tolerance),
     };
-    mesh.stats.merged = merges;
     drop(grid);
-    mesh.triangles = triangles;
-    compact(&mut mesh);
-    mesh.stats.vertices = mesh.positions.len() as u64;
-    mesh.stats.triangles = mesh.triangles.len() as u64;
-    Ok(mesh)
+    let Units {
+        mut triangles,
+        merges,
+    } = units;
+    // Stable: within an owner, the order the steps made them in, which no cut changes.
+    triangles.sort_by_key(|&(owner, _)| owner);
+    let (owners, triangles) = triangles.into_iter().unzip();
+    Ok(Run {
+        rec,
+        triangles,
+        owners,
+        merges,
+    })
 }
 
 /// A box on the lattice of its size: whether it may replace its cubes.
@@ -163,10 +214,17 @@ enum Cell {
 /// Per box size `2^ℓ`, from `ℓ = 1`: the boxes along each axis, and each one's decision.
 type Lattice = Vec<([usize; 3], Vec<Cell>)>;
 
-/// The volume, its Steps 1–3 mesh and the lookups the boxes need.
+/// The volume, its Steps 1–3 mesh and the lookups the boxes need. Points, keys and boxes are
+/// named in the whole grid's indices; the samples at hand start at `at`.
 struct Grid<'a, T: Scalar> {
     data: &'a [T],
+    /// Samples of the whole grid.
     dims: [usize; 3],
+    /// Where the samples at hand start, a multiple of every box side, so that the boxes within
+    /// them lie on the whole grid's lattice.
+    at: [usize; 3],
+    /// Samples at hand.
+    local: [usize; 3],
     iso: f64,
     threshold: T::Threshold,
     /// Vertex edge keys with their ids, sorted by key.
@@ -179,7 +237,13 @@ struct Grid<'a, T: Scalar> {
 }
 
 impl<'a, T: Scalar> Grid<'a, T> {
-    fn new(volume: &Volume<'a, T>, iso: f64, rec: &'a Recorded, triangles: &'a [[u32; 3]]) -> Self {
+    fn new(
+        volume: &Volume<'a, T>,
+        at: [usize; 3],
+        grid: [usize; 3],
+        iso: f64,
+        rec: &'a Recorded,
+    ) -> Self {
         // Each key with its index, in key order.
         let sorted = |keys: &[u64]| -> Vec<(u64, u32)> {
             let mut v: Vec<(u64, u32)> = keys
@@ -193,12 +257,14 @@ impl<'a, T: Scalar> Grid<'a, T> {
         let (vertex_of, by_cube) = (sorted(&rec.edges), sorted(&rec.cubes));
         Grid {
             data: volume.data(),
-            dims: volume.dims(),
+            dims: grid,
+            at,
+            local: volume.dims(),
             iso,
             threshold: T::threshold(iso),
             vertex_of,
             by_cube,
-            triangles,
+            triangles: &rec.mesh.triangles,
             rec,
         }
     }
@@ -208,7 +274,13 @@ impl<'a, T: Scalar> Grid<'a, T> {
     }
 
     fn sample(&self, p: [usize; 3]) -> T {
-        self.data[p[0] + self.dims[0] * (p[1] + self.dims[1] * p[2])]
+        let [x, y, z]: [usize; 3] = core::array::from_fn(|d| p[d] - self.at[d]);
+        self.data[x + self.local[0] * (y + self.local[1] * z)]
+    }
+
+    /// The global lower corner of the box of `side` with local lattice index `cell`.
+    fn corner(&self, cell: [usize; 3], side: usize) -> [usize; 3] {
+        core::array::from_fn(|d| cell[d] * side + self.at[d])
     }
 
     fn vertex_id(&self, lower: [usize; 3], axis: usize) -> Option<u32> {
@@ -276,7 +348,10 @@ impl<'a, T: Scalar> Grid<'a, T> {
         let mut buf = PatchBuf::default();
         for level in 1..=levels {
             let side = 1 << level;
-            let cells = self.dims.map(|d| (d - 1) / side);
+            let cells = self.local.map(|d| (d - 1) / side);
+            // Whether a face has a box across is the whole grid's question: a box decides
+            // alike wherever its samples are at hand.
+            let grid_cells = self.dims.map(|d| (d - 1) / side);
             if cells.contains(&0) {
                 break;
             }
@@ -293,13 +368,14 @@ impl<'a, T: Scalar> Grid<'a, T> {
                         continue;
                     }
                 }
-                let corner = cell.map(|c| c * side);
+                let corner = self.corner(cell, side);
+                let global = corner.map(|c| c / side);
                 *state = match outline(self, corner, side) {
                     Shape::Empty => Cell::Empty,
                     Shape::Complex => Cell::Cubes,
                     Shape::Simple(o) => {
                         let may_chord = (0..o.n).fold(0u8, |m, i| {
-                            match neighbour(cell, usize::from(o.arc_face[i]), cells) {
+                            match neighbour(global, usize::from(o.arc_face[i]), grid_cells) {
                                 Some(_) => m | 1 << i,
                                 None => m,
                             }
@@ -318,22 +394,23 @@ impl<'a, T: Scalar> Grid<'a, T> {
         lattice
     }
 
-    /// The triangles: those of unit cubes outside boxes, in sweep order, then each box's, size
-    /// by size, in the variant its neighbours give it. `level` is the balanced size of the box
-    /// holding each pair of cubes (`final_levels`).
+    /// The triangles with their owners: those of unit cubes outside boxes, then each box's,
+    /// size by size, in the variant its neighbours give it. `level` is the balanced size of the
+    /// box holding each pair of cubes (`final_levels`).
     fn emit(
         &self,
         lattice: &Lattice,
         level: &[u8],
         tolerance: &Tolerance,
         merged: &Recorded,
-    ) -> (Vec<[u32; 3]>, u64) {
+    ) -> Units {
         let pairs = lattice[0].0;
         let in_box = |cube_key: u64| -> bool {
-            let pair = unkey(cube_key as usize, self.dims).map(|c| c / 2);
+            let cube = unkey(cube_key as usize, self.dims);
+            let pair: [usize; 3] = core::array::from_fn(|d| (cube[d] - self.at[d]) / 2);
             (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
-        let (mut out, merges) = self.emit_units(merged, in_box, tolerance);
+        let mut out = self.emit_units(merged, in_box, tolerance);
         let mut buf = PatchBuf::default();
         for (l, (cells, states)) in lattice.iter().enumerate() {
             let (l, side) = (l as u8 + 1, 2usize << l);
@@ -343,7 +420,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
                 if state != Cell::Box || level[cell_index(first, pairs)] != l {
                     continue;
                 }
-                let corner = cell.map(|c| c * side);
+                let corner = self.corner(cell, side);
                 let Shape::Simple(o) = outline(self, corner, side) else {
                     continue;
                 };
@@ -363,25 +440,26 @@ impl<'a, T: Scalar> Grid<'a, T> {
                     debug_assert!(false, "an accepted box failed its variant");
                     continue;
                 };
+                let owner = self.key(corner);
                 for tri in t.triangles() {
                     let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
                     if let [Some(a), Some(b), Some(c)] = ids {
-                        out.push([a, b, c]);
+                        out.triangles.push((owner, [a, b, c]));
                     }
                 }
             }
         }
-        (out, merges)
+        out
     }
 
     /// The triangles of the unit cubes outside boxes, with embedded mode's merges where no box
-    /// is near ([`merged::unit_triangles`]), and the number of merges kept.
+    /// is near ([`merged::unit_triangles`]).
     fn emit_units(
         &self,
         merged: &Recorded,
         in_box: impl Fn(u64) -> bool,
         tolerance: &Tolerance,
-    ) -> (Vec<[u32; 3]>, u64) {
+    ) -> Units {
         let id = |key: u64| {
             let i = self.vertex_of.partition_point(|&(k, _)| k < key);
             self.vertex_of[i].1
@@ -534,36 +612,15 @@ fn neighbour(cell: [usize; 3], face: usize, cells: [usize; 3]) -> Option<usize> 
 
 /// Drops the vertices no triangle uses, keeping the others' order.
 fn compact(mesh: &mut Mesh) {
-    let n = mesh.positions.len();
-    let mut new_id = vec![u32::MAX; n];
-    for t in &mesh.triangles {
-        for &v in t {
-            new_id[v as usize] = 0;
-        }
-    }
-    let mut next = 0u32;
-    for id in new_id.iter_mut() {
-        if *id == 0 {
-            *id = next;
-            next += 1;
-        }
-    }
-    keep_column(&mut mesh.positions, &new_id);
-    keep_column(&mut mesh.normals, &new_id);
-    keep_column(&mut mesh.values, &new_id);
-    for t in &mut mesh.triangles {
-        *t = t.map(|v| new_id[v as usize]);
-    }
+    let kept = keep_used(mesh.positions.len(), &mut mesh.triangles);
+    keep_column(&mut mesh.positions, &kept);
+    keep_column(&mut mesh.normals, &kept);
+    keep_column(&mut mesh.values, &kept);
 }
 
-/// Keeps the entries of a per-vertex column (empty when not asked for) whose vertex stays.
-fn keep_column<C>(column: &mut Vec<C>, new_id: &[u32]) {
-    if column.is_empty() {
-        return;
+/// Keeps the entries `kept` of a per-vertex column (empty when not asked for).
+fn keep_column<C: Copy>(column: &mut Vec<C>, kept: &[usize]) {
+    if !column.is_empty() {
+        *column = kept.iter().map(|&v| column[v]).collect();
     }
-    let mut i = 0;
-    column.retain(|_| {
-        i += 1;
-        new_id[i - 1] != u32::MAX
-    });
 }
