@@ -64,6 +64,10 @@ pub struct Settings {
     pub origin: [f64; 3],
     /// Step 4's bound, if any.
     pub max_error: Option<ErrorBound>,
+    /// Adaptive mode's largest box, if given: shares made with other boxes do not join.
+    pub max_box: Option<u32>,
+    /// Adaptive mode: whether boxes may leave samples on the wrong side.
+    pub allow_wrong_side: bool,
 }
 
 impl From<&Params> for Settings {
@@ -75,6 +79,8 @@ impl From<&Params> for Settings {
             spacing: p.spacing,
             origin: p.origin,
             max_error: p.max_error,
+            max_box: p.max_box,
+            allow_wrong_side: p.allow_wrong_side,
         }
     }
 }
@@ -88,6 +94,8 @@ impl Settings {
             spacing: self.spacing,
             origin: self.origin,
             max_error: self.max_error,
+            max_box: self.max_box,
+            allow_wrong_side: self.allow_wrong_side,
             ..Params::new(self.iso)
         }
     }
@@ -100,6 +108,8 @@ impl Settings {
             "spacing": self.spacing,
             "origin": self.origin,
             "max_error": self.max_error.map(report::bound),
+            "max_box": self.max_box,
+            "allow_wrong_side": self.allow_wrong_side,
         })
     }
 
@@ -131,6 +141,22 @@ impl Settings {
             .filter(|x| x.is_finite())
             .ok_or_else(|| format!("settings: iso {} is not a finite number", v["iso"]))?;
         let normals = v["normals"].as_bool().ok_or("settings: no normals flag")?;
+        // Absent in shards written before adaptive mode ran in blocks: the defaults.
+        let max_box = match &v["max_box"] {
+            Value::Null => None,
+            b => Some(
+                b.as_u64()
+                    .and_then(|n| u32::try_from(n).ok())
+                    .filter(|n| n.is_power_of_two())
+                    .ok_or_else(|| format!("settings: max_box {b} is not a power of two"))?,
+            ),
+        };
+        let allow_wrong_side = match &v["allow_wrong_side"] {
+            Value::Null => false,
+            b => b
+                .as_bool()
+                .ok_or_else(|| format!("settings: allow_wrong_side {b} is not true or false"))?,
+        };
         Ok(Settings {
             iso,
             mode,
@@ -138,6 +164,8 @@ impl Settings {
             spacing: coordinates(&v["spacing"], "settings: spacing")?,
             origin: coordinates(&v["origin"], "settings: origin")?,
             max_error,
+            max_box,
+            allow_wrong_side,
         })
     }
 }
@@ -789,6 +817,43 @@ mod tests {
         let positions = npz.by_name("positions").unwrap().unwrap();
         assert_eq!(positions.shape(), [block.keys.len() as u64, 3]);
         assert_eq!(positions.dtype().descr(), "'<f4'");
+
+        // Adaptive mode's box settings travel with the shard, and tell its shares apart.
+        let adaptive = Params {
+            mode: Mode::Adaptive,
+            max_box: Some(4),
+            allow_wrong_side: true,
+            ..params
+        };
+        let block = extract_block(&volume, [0; 3], v.dims, [0..19, 0..19, 0..19], &adaptive).unwrap();
+        write_shard(&path, &block, &Settings::from(&adaptive)).unwrap();
+        let (back, settings) = read_shard(&path).unwrap();
+        assert_eq!((back, settings), (block, Settings::from(&adaptive)));
+        assert_eq!(settings.params().max_box, Some(4));
+        assert!(settings.params().allow_wrong_side);
+        for other in [
+            Params { max_box: Some(8), ..adaptive },
+            Params { max_box: None, ..adaptive },
+            Params { allow_wrong_side: false, ..adaptive },
+        ] {
+            assert_ne!(Settings::from(&other), settings);
+        }
+    }
+
+    /// Settings written before the box settings existed read with their defaults; bad ones are
+    /// refused by name.
+    #[test]
+    fn box_settings_default_and_are_checked() {
+        let mut v = Settings::from(&Params::new(1.5)).to_json();
+        v.as_object_mut().unwrap().remove("max_box");
+        v.as_object_mut().unwrap().remove("allow_wrong_side");
+        let s = Settings::from_json(&v).unwrap();
+        assert_eq!((s.max_box, s.allow_wrong_side), (None, false));
+        v["max_box"] = json!(3);
+        assert!(Settings::from_json(&v).unwrap_err().contains("max_box 3"));
+        v["max_box"] = json!(16);
+        v["allow_wrong_side"] = json!("yes");
+        assert!(Settings::from_json(&v).unwrap_err().contains("allow_wrong_side"));
     }
 
     /// `path` rewritten as NumPy writes `np.asfortranarray` arrays: every `(n, 3)` array in
