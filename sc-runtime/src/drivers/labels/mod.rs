@@ -125,10 +125,17 @@ pub fn extract_labels<L: Label>(
     check(params)?;
     let grid = Padded::new(volume, params);
     let layers = grid.n[2].saturating_sub(1);
+    // One thread sweeps the grid as one piece: pieces only share the work out, and joining
+    // them copies the whole output and sweeps each piece's constructions anew. The atlas is the
+    // same for any piece size.
+    let piece = match params.threads == 1 || cfg!(not(feature = "std")) {
+        true => layers.max(1),
+        false => PIECE_LAYERS,
+    };
     let ranges: Vec<Range<usize>> = if grid.n.iter().all(|&n| n >= 2) {
         (0..layers)
-            .step_by(PIECE_LAYERS)
-            .map(|k| k..(k + PIECE_LAYERS).min(layers))
+            .step_by(piece)
+            .map(|k| k..(k + piece).min(layers))
             .collect()
     } else {
         Vec::new()
