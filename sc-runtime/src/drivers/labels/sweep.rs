@@ -83,6 +83,32 @@ impl<'a, L: Label> Padded<'a, L> {
         self.data[q[0] + self.dims[0] * (q[1] + self.dims[1] * q[2])]
     }
 
+    /// The labels at `p` plus each of `offsets` (each within one sample of `p`), `None` where
+    /// that leaves the padded grid: read straight from the samples where all of them lie in
+    /// the data, as they do but near the volume's border.
+    #[inline]
+    pub fn around<const N: usize>(
+        &self,
+        p: [usize; 3],
+        offsets: &[[isize; 3]; N],
+    ) -> [Option<L>; N] {
+        let start = |a: usize| self.pad + self.at[a];
+        if (0..3).all(|a| p[a] > start(a) && p[a] + 1 < start(a) + self.dims[a]) {
+            let [dx, dy, _] = self.dims;
+            let q: [usize; 3] = core::array::from_fn(|a| p[a] - start(a));
+            let base = q[0] + dx * (q[1] + dy * q[2]);
+            let stride = [1, dx as isize, (dx * dy) as isize];
+            return offsets.map(|d| {
+                let step = d[0] * stride[0] + d[1] * stride[1] + d[2] * stride[2];
+                Some(self.data[base.wrapping_add_signed(step)])
+            });
+        }
+        offsets.map(|d| {
+            let q: [usize; 3] = core::array::from_fn(|a| p[a].wrapping_add_signed(d[a]));
+            (q.iter().zip(&self.n).all(|(&c, &m)| c < m)).then(|| self.at(q))
+        })
+    }
+
     /// Copies the samples `xs × ys` of plane `z` of the padded grid into `out`, row by row.
     pub fn plane(&self, z: usize, xs: Range<usize>, ys: Range<usize>, out: &mut [L]) {
         let w = xs.len();
