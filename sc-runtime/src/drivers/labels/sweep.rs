@@ -254,7 +254,9 @@ impl Ids {
 }
 
 /// The vertex in `slot` (see [`Ids`]), made by `make` if it has none yet.
-#[inline]
+// Always inlined: a cube's few vertex lookups are most of a surface cube's work, and the call
+// around one costs as much as the lookup.
+#[inline(always)]
 fn shared(
     (slot, since): (&mut u32, u32),
     make: impl FnOnce() -> Result<u32, Error>,
@@ -305,7 +307,7 @@ impl<L> Out<'_, L> {
 
     /// A new vertex at the midpoint of cube edge `e` of `cube`.
     fn edge_vertex(&mut self, cube: [usize; 3], e: u8) -> Result<u32, Error> {
-        let id = self.vertex(cube, Local::Edge(e).quarters())?;
+        let id = self.vertex(cube, EDGE_QUARTERS[usize::from(e)])?;
         if let Some(edges) = &mut self.edges {
             let [x, y, z] = edge_lower(cube, e);
             // The padded grid's sizes fit in u32 (its vertex ids do).
@@ -617,6 +619,17 @@ fn edge_lower(cube: [usize; 3], e: u8) -> [usize; 3] {
     let o = EDGE_LOWER[usize::from(e)];
     [cube[0] + o[0], cube[1] + o[1], cube[2] + o[2]]
 }
+
+/// Each cube edge's midpoint, in quarters of a side from the cube's lower corner.
+const EDGE_QUARTERS: [[i32; 3]; 12] = {
+    let mut out = [[0; 3]; 12];
+    let mut e = 0;
+    while e < 12 {
+        out[e] = Local::Edge(e as u8).quarters();
+        e += 1;
+    }
+    out
+};
 
 /// Each cube edge's lower end, from the cube's lower corner.
 const EDGE_LOWER: [[usize; 3]; 12] = {
