@@ -267,14 +267,29 @@ impl<L> Default for Atlas<L> {
 impl<L: Label> Atlas<L> {
     /// The labels with a surface, ascending, without the background (`background`).
     pub fn labels(&self, background: L) -> Vec<L> {
-        // Neighbouring triangles mostly share their pair: skipping repeats first leaves little
-        // to sort.
+        // Neighbouring triangles often share their pair, and labels are mostly small integers,
+        // which a table marks as met: what is left to sort is little more than the labels.
         let mut labels: Vec<L> = Vec::new();
+        let mut met: Vec<bool> = Vec::new();
         let mut last = None;
         for &pair in &self.pairs {
-            if last != Some(pair) {
-                labels.extend(pair);
-                last = Some(pair);
+            if last == Some(pair) {
+                continue;
+            }
+            last = Some(pair);
+            for l in pair {
+                match l.index().filter(|&i| i < 1 << 16) {
+                    Some(i) => {
+                        if i >= met.len() {
+                            met.resize(i + 1, false);
+                        }
+                        if !met[i] {
+                            met[i] = true;
+                            labels.push(l);
+                        }
+                    }
+                    None => labels.push(l),
+                }
             }
         }
         labels.sort_unstable();
