@@ -8,7 +8,8 @@
 //! cargo run --release -p sc-runtime --example time_labels -- \
 //!     /work/shared/data/labels/aal-atlas/aal-atlas.raw 181,217,181 u8 5
 //! ```
-//! The volume is raw little-endian, x fastest; dtype is u8, u16 or u32.
+//! The volume is raw little-endian, x fastest; dtype is u8, u16 or u32. The background is 0
+//! unless given.
 
 use std::time::{Duration, Instant};
 
@@ -17,17 +18,18 @@ use sc_runtime::{Mesh, Volume};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let [_, path, dims, dtype, runs] = args.as_slice() else {
-        return Err("usage: time_labels VOLUME.raw NX,NY,NZ DTYPE RUNS".into());
+    let [_, path, dims, dtype, runs, rest @ ..] = args.as_slice() else {
+        return Err("usage: time_labels VOLUME.raw NX,NY,NZ DTYPE RUNS [BACKGROUND]".into());
     };
+    let background: u64 = rest.first().map_or(Ok(0), |b| b.parse())?;
     let dims: Vec<usize> = dims.split(',').map(str::parse).collect::<Result<_, _>>()?;
     let dims: [usize; 3] = dims.try_into().map_err(|_| "three dims")?;
     let runs: usize = runs.parse()?;
     let raw = std::fs::read(path)?;
     match dtype.as_str() {
-        "u8" => time(&raw, dims, runs),
-        "u16" => time(&cast(&raw, u16::from_le_bytes), dims, runs),
-        "u32" => time(&cast(&raw, u32::from_le_bytes), dims, runs),
+        "u8" => time(&raw, dims, runs, background),
+        "u16" => time(&cast(&raw, u16::from_le_bytes), dims, runs, background),
+        "u32" => time(&cast(&raw, u32::from_le_bytes), dims, runs, background),
         other => Err(format!("unknown dtype {other}").into()),
     }
 }
@@ -38,13 +40,15 @@ fn cast<T, const N: usize>(raw: &[u8], from: fn([u8; N]) -> T) -> Vec<T> {
         .collect()
 }
 
-fn time<L: Label + Into<u64>>(
+fn time<L: Label + Into<u64> + TryFrom<u64>>(
     data: &[L],
     dims: [usize; 3],
     runs: usize,
+    background: u64,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let volume = Volume::new(data, dims)?;
     let params = LabelParams {
+        background: L::try_from(background).map_err(|_| "background out of range")?,
         threads: 1,
         ..LabelParams::default()
     };
