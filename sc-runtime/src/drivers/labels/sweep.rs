@@ -135,6 +135,28 @@ impl<'a, L: Label> Padded<'a, L> {
         }
     }
 
+    /// `kind`, [`few_labels`] of the labels themselves, as it is of their keys: the keys order
+    /// two labels unlike the labels only when the larger is the background, which then plays
+    /// empty. (Comparing labels is cheaper than comparing keys, and one or two labels is most
+    /// cubes with a surface.)
+    #[inline]
+    pub fn by_key(&self, labels: &[L; 8], kind: Kind) -> Kind {
+        match kind {
+            Kind::Binary { background, case } => {
+                let other = case.trailing_zeros() as usize;
+                if self.key(labels[other]) < self.key(labels[usize::from(background)]) {
+                    Kind::Binary {
+                        background: other as u8,
+                        case: !case,
+                    }
+                } else {
+                    kind
+                }
+            }
+            kind => kind,
+        }
+    }
+
     /// The order of labels for the face rule: the background first, then ascending.
     #[inline]
     pub fn key(&self, l: L) -> (bool, L) {
@@ -419,10 +441,9 @@ pub(super) fn sweep<L: Label>(
                         vertex: out.atlas.positions.len() as u32,
                     });
                 }
-                let keys = labels.map(|l| grid.key(l));
-                let (kind, built) = match few_labels(&keys) {
-                    Some(kind) => (kind, &[][..]),
-                    None => patterns.get(&keys),
+                let (kind, built) = match few_labels(&labels) {
+                    Some(kind) => (grid.by_key(&labels, kind), &[][..]),
+                    None => patterns.get(&labels.map(|l| grid.key(l))),
                 };
                 match kind {
                     Kind::Uniform => {}
