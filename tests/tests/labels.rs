@@ -576,6 +576,42 @@ fn any_thread_count_gives_the_same_atlas() {
     }
 }
 
+/// Labels are read only through their order with the background first: background 1 meshes a
+/// volume as background 0 meshes it with labels 0 and 1 swapped, since the swap maps the first
+/// order onto the second. The cubes where the background is not the smaller label are there.
+#[test]
+fn another_background_is_a_relabelling() {
+    let vol = cells([14, 12, 11], 12, 5);
+    let swap = |l: u16| match l {
+        0 => 1,
+        1 => 0,
+        l => l,
+    };
+    let swapped: Vec<u16> = vol.data.iter().map(|&l| swap(l)).collect();
+    for mode in MODES {
+        let atlas = |data: &[u16], background| {
+            let volume = Volume::new(data, vol.dims).unwrap();
+            let params = LabelParams {
+                background,
+                mode,
+                ..LabelParams::default()
+            };
+            extract_labels(volume, &params).unwrap()
+        };
+        let one = atlas(&vol.data, 1);
+        let zero = atlas(&swapped, 0);
+        assert!(
+            one.pairs.iter().any(|p| p.contains(&0) && p.contains(&1)),
+            "{mode:?}: no interface between labels 0 and 1"
+        );
+        assert_eq!(one.positions, zero.positions, "{mode:?}");
+        assert_eq!(one.triangles, zero.triangles, "{mode:?}");
+        assert_eq!(one.stats, zero.stats, "{mode:?}");
+        let pairs: Vec<[u16; 2]> = one.pairs.iter().map(|p| p.map(swap)).collect();
+        assert_eq!(pairs, zero.pairs, "{mode:?}");
+    }
+}
+
 /// A ball of `r` voxels' radius, digitised at the samples of a cube of side `2r + 6`.
 fn ball(r: f64) -> Labels {
     let n = (2.0 * r) as usize + 6;

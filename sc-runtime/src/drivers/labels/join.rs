@@ -12,24 +12,31 @@ use super::{Atlas, Label};
 pub(super) fn join<L: Label>(
     pieces: Vec<Piece<L>>,
 ) -> (Atlas<L>, Vec<Ear<L>>, Vec<Edge>, Vec<u32>) {
-    let mut atlas = Atlas::default();
-    let mut ears = Vec::new();
-    let mut edges = Vec::new();
-    let mut pinned = Vec::new();
+    let mut pieces = pieces.into_iter();
+    let Some(first) = pieces.next() else {
+        return (Atlas::default(), Vec::new(), Vec::new(), Vec::new());
+    };
+    // The first piece's numbering is the joined one: it is taken whole, not copied.
+    let Piece {
+        mut atlas,
+        mut ears,
+        mut edges,
+        mut pinned,
+        top,
+        ..
+    } = first;
     // The previous piece's top plane, in the joined numbering (plus one, 0 for none).
-    let mut shared: Option<[Vec<u32>; 3]> = None;
+    let mut shared = top;
     for piece in pieces {
         let mut number = vec![u32::MAX; piece.atlas.positions.len()];
-        if let Some(below) = &shared {
-            for (mine, theirs) in piece.bottom.iter().zip(below) {
-                for (&m, &t) in mine.iter().zip(theirs) {
-                    if m != 0 {
-                        debug_assert!(
-                            t != 0,
-                            "a vertex of the shared plane made by one piece only"
-                        );
-                        number[m as usize - 1] = t - 1;
-                    }
+        for (mine, theirs) in piece.bottom.iter().zip(&shared) {
+            for (&m, &t) in mine.iter().zip(theirs) {
+                if m != 0 {
+                    debug_assert!(
+                        t != 0,
+                        "a vertex of the shared plane made by one piece only"
+                    );
+                    number[m as usize - 1] = t - 1;
                 }
             }
         }
@@ -57,7 +64,7 @@ pub(super) fn join<L: Label>(
             triangle: first_triangle + ear.triangle,
             ..ear
         }));
-        shared = Some(piece.top.map(|plane| {
+        shared = piece.top.map(|plane| {
             plane
                 .iter()
                 .map(|&v| {
@@ -68,7 +75,7 @@ pub(super) fn join<L: Label>(
                     }
                 })
                 .collect()
-        }));
+        });
     }
     (atlas, ears, edges, pinned)
 }

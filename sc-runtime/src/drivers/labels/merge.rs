@@ -135,48 +135,44 @@ fn quad<L>(atlas: &Atlas<L>, ears: [&Ear<L>; 4]) -> Option<[[u32; 3]; 2]> {
     }
 }
 
+/// The samples SPEC §5 (b) reads around a grey edge's lower end, as offsets: the 3 × 3 square
+/// across z (`x + 3y`, the centre at 4), then the two along z.
+const AROUND: [[isize; 3]; 11] = {
+    let mut out = [[0; 3]; 11];
+    let mut i = 0;
+    while i < 9 {
+        out[i] = [i as isize % 3 - 1, i as isize / 3 - 1, 0];
+        i += 1;
+    }
+    out[9] = [0, 0, -1];
+    out[10] = [0, 0, 1];
+    out
+};
+
 /// Whether SPEC §5 (b) blocks the grey edge from `p` along `axis` on the indicator "label ≠
 /// `w`", or a sample it reads has a third label.
 fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> bool {
-    let mut up = p;
-    up[axis] += 1;
-    let x = if grid.at(p) == w {
-        grid.at(up)
-    } else {
-        grid.at(p)
-    };
-    let n = grid.n;
-    let inside = |a: usize| p[a] >= 1 && p[a] + 1 < n[a];
-    let at = |d: [isize; 3]| {
-        let q: [usize; 3] = core::array::from_fn(|a| p[a].wrapping_add_signed(d[a]));
-        (q.iter().zip(&n).all(|(&c, &m)| c < m)).then(|| grid.at(q))
-    };
-    let plane: [[isize; 3]; 9] =
-        core::array::from_fn(|i| [i as isize % 3 - 1, i as isize / 3 - 1, 0]);
-    let column = [[0, 0, -1], [0, 0, 1]];
-    let read = plane
-        .iter()
-        .chain(if axis == 2 { &column[..] } else { &[] });
-    if read
-        .clone()
-        .filter_map(|&d| at(d))
-        .any(|l| l != w && l != x)
-    {
+    let s = grid.around(p, &AROUND);
+    // The edge's other end: along x and y in the square, along z in the column.
+    let up = [5, 7, 10][axis];
+    let x = if s[4] == Some(w) { s[up] } else { s[4] };
+    let read = if axis == 2 { &s[..] } else { &s[..9] };
+    if read.iter().flatten().any(|&l| l != w && Some(l) != x) {
         return true;
     }
+    let n = grid.n;
+    let inside = |a: usize| p[a] >= 1 && p[a] + 1 < n[a];
     if !(inside(0) && inside(1)) || axis == 2 && !inside(2) {
         return false;
     }
-    let filled = |d: [isize; 3]| at(d).is_some_and(|l| l != w);
-    let centre = filled([0, 0, 0]);
-    let faces = [[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0]]
-        .into_iter()
-        .all(|d| filled(d) != centre);
+    let filled = |i: usize| s[i].is_some_and(|l| l != w);
+    let centre = filled(4);
+    // −x, +x, −y, +y.
+    let faces = [3, 5, 1, 7].into_iter().all(|i| filled(i) != centre);
     if axis == 2 {
-        faces && column.into_iter().all(|d| filled(d) != centre)
+        faces && [9, 10].into_iter().all(|i| filled(i) != centre)
     } else {
-        let corners = [[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]];
-        faces && (centre || corners.into_iter().all(filled))
+        faces && (centre || [0, 2, 6, 8].into_iter().all(filled))
     }
 }
 

@@ -32,12 +32,20 @@ pub trait Label: Copy + Ord + Send + Sync + core::fmt::Debug + 'static + sealed:
 }
 
 mod sealed {
-    pub trait Sealed {}
+    pub trait Sealed {
+        /// The label as an index, if it is a non-negative integer that fits one.
+        fn index(self) -> Option<usize>;
+    }
 }
 
 macro_rules! label {
     ($($t:ty),*) => {$(
-        impl sealed::Sealed for $t {}
+        impl sealed::Sealed for $t {
+            #[inline]
+            fn index(self) -> Option<usize> {
+                usize::try_from(self).ok()
+            }
+        }
         impl Label for $t {
             const ZERO: Self = 0;
         }
@@ -117,10 +125,17 @@ pub fn extract_labels<L: Label>(
     check(params)?;
     let grid = Padded::new(volume, params);
     let layers = grid.n[2].saturating_sub(1);
+    // One thread sweeps the grid as one piece: pieces only share the work out, and joining
+    // them copies the whole output and sweeps each piece's constructions anew. The atlas is the
+    // same for any piece size.
+    let piece = match params.threads == 1 || cfg!(not(feature = "std")) {
+        true => layers.max(1),
+        false => PIECE_LAYERS,
+    };
     let ranges: Vec<Range<usize>> = if grid.n.iter().all(|&n| n >= 2) {
         (0..layers)
-            .step_by(PIECE_LAYERS)
-            .map(|k| k..(k + PIECE_LAYERS).min(layers))
+            .step_by(piece)
+            .map(|k| k..(k + piece).min(layers))
             .collect()
     } else {
         Vec::new()
@@ -252,14 +267,29 @@ impl<L> Default for Atlas<L> {
 impl<L: Label> Atlas<L> {
     /// The labels with a surface, ascending, without the background (`background`).
     pub fn labels(&self, background: L) -> Vec<L> {
-        // Neighbouring triangles mostly share their pair: skipping repeats first leaves little
-        // to sort.
+        // Neighbouring triangles often share their pair, and labels are mostly small integers,
+        // which a table marks as met: what is left to sort is little more than the labels.
         let mut labels: Vec<L> = Vec::new();
+        let mut met: Vec<bool> = Vec::new();
         let mut last = None;
         for &pair in &self.pairs {
-            if last != Some(pair) {
-                labels.extend(pair);
-                last = Some(pair);
+            if last == Some(pair) {
+                continue;
+            }
+            last = Some(pair);
+            for l in pair {
+                match l.index().filter(|&i| i < 1 << 16) {
+                    Some(i) => {
+                        if i >= met.len() {
+                            met.resize(i + 1, false);
+                        }
+                        if !met[i] {
+                            met[i] = true;
+                            labels.push(l);
+                        }
+                    }
+                    None => labels.push(l),
+                }
             }
         }
         labels.sort_unstable();
@@ -273,16 +303,16 @@ impl<L: Label> Atlas<L> {
     /// flipped. With `normals`, each vertex gets the normalised sum of its triangles' area
     /// normals in that mesh.
     pub fn meshes(&self, labels: &[L], normals: bool) -> Vec<(L, Mesh)> {
-        let index = |l: &L| labels.binary_search(l).ok();
-        let mut buckets: Vec<Vec<[u32; 3]>> = vec![Vec::new(); labels.len()];
-        for (t, pair) in self.triangles.iter().zip(&self.pairs) {
-            if let Some(i) = index(&pair[0]) {
-                buckets[i].push(*t);
-            }
-            if let Some(i) = index(&pair[1]) {
-                buckets[i].push([t[0], t[2], t[1]]);
-            }
-        }
+        // Counted first, so that each label's triangles are one allocation, not a doubling
+        // series of copies.
+        let find = Find::new(labels, self.triangles.len());
+        let mut counts = vec![0usize; labels.len()];
+        self.each_side(&find, |i, _, _| counts[i] += 1);
+        let mut buckets: Vec<Vec<[u32; 3]>> =
+            counts.iter().map(|&n| Vec::with_capacity(n)).collect();
+        self.each_side(&find, |i, t, first| {
+            buckets[i].push(if first { *t } else { [t[0], t[2], t[1]] });
+        });
         let mut local = vec![u32::MAX; self.positions.len()];
         labels
             .iter()
@@ -291,11 +321,25 @@ impl<L: Label> Atlas<L> {
             .collect()
     }
 
+    /// Calls `side(i, triangle, first)` for each triangle and each of its labels that is
+    /// `labels[i]`: `first` if it is the label the triangle faces away from.
+    fn each_side(&self, find: &Find<'_, L>, mut side: impl FnMut(usize, &[u32; 3], bool)) {
+        for (t, pair) in self.triangles.iter().zip(&self.pairs) {
+            if let Some(i) = find.get(pair[0]) {
+                side(i, t, true);
+            }
+            if let Some(i) = find.get(pair[1]) {
+                side(i, t, false);
+            }
+        }
+    }
+
     /// The mesh of `triangles` (atlas indices), renumbered in order of first use; `local` is
     /// all `u32::MAX` on entry and on return.
     fn mesh_of(&self, mut triangles: Vec<[u32; 3]>, local: &mut [u32], normals: bool) -> Mesh {
-        let mut positions = Vec::new();
-        let mut used = Vec::new();
+        // A closed surface has about half as many vertices as triangles.
+        let mut positions = Vec::with_capacity(triangles.len() / 2 + 2);
+        let mut used = Vec::with_capacity(positions.capacity());
         for t in &mut triangles {
             for v in t.iter_mut() {
                 let slot = &mut local[*v as usize];
@@ -327,6 +371,45 @@ impl<L: Label> Atlas<L> {
             triangles,
             stats,
         }
+    }
+}
+
+/// Where each label is in an ascending list of labels: by a table when the labels are small
+/// non-negative integers, as a segmentation's are, since neighbouring triangles' pairs differ
+/// too often to look up once per run; by binary search otherwise.
+struct Find<'a, L> {
+    labels: &'a [L],
+    /// Per label value, its index in `labels`, `u32::MAX` for none; empty for binary search.
+    table: Vec<u32>,
+}
+
+impl<'a, L: Label> Find<'a, L> {
+    /// The table is kept no longer than 2¹⁶ or `size` entries, whichever is more: a few
+    /// lookups' worth of memory per triangle at most.
+    fn new(labels: &'a [L], size: usize) -> Self {
+        let small = labels.first().and_then(|l| l.index()).is_some();
+        let table = match labels.last().and_then(|l| l.index()) {
+            Some(max) if small && max < size.max(1 << 16) => {
+                let mut table = vec![u32::MAX; max + 1];
+                for (i, l) in labels.iter().enumerate() {
+                    if let Some(v) = l.index() {
+                        table[v] = i as u32;
+                    }
+                }
+                table
+            }
+            _ => Vec::new(),
+        };
+        Find { labels, table }
+    }
+
+    #[inline]
+    fn get(&self, l: L) -> Option<usize> {
+        if self.table.is_empty() {
+            return self.labels.binary_search(&l).ok();
+        }
+        let i = *self.table.get(l.index()?)?;
+        (i != u32::MAX).then_some(i as usize)
     }
 }
 

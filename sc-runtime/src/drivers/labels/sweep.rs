@@ -83,6 +83,32 @@ impl<'a, L: Label> Padded<'a, L> {
         self.data[q[0] + self.dims[0] * (q[1] + self.dims[1] * q[2])]
     }
 
+    /// The labels at `p` plus each of `offsets` (each within one sample of `p`), `None` where
+    /// that leaves the padded grid: read straight from the samples where all of them lie in
+    /// the data, as they do but near the volume's border.
+    #[inline]
+    pub fn around<const N: usize>(
+        &self,
+        p: [usize; 3],
+        offsets: &[[isize; 3]; N],
+    ) -> [Option<L>; N] {
+        let start = |a: usize| self.pad + self.at[a];
+        if (0..3).all(|a| p[a] > start(a) && p[a] + 1 < start(a) + self.dims[a]) {
+            let [dx, dy, _] = self.dims;
+            let q: [usize; 3] = core::array::from_fn(|a| p[a] - start(a));
+            let base = q[0] + dx * (q[1] + dy * q[2]);
+            let stride = [1, dx as isize, (dx * dy) as isize];
+            return offsets.map(|d| {
+                let step = d[0] * stride[0] + d[1] * stride[1] + d[2] * stride[2];
+                Some(self.data[base.wrapping_add_signed(step)])
+            });
+        }
+        offsets.map(|d| {
+            let q: [usize; 3] = core::array::from_fn(|a| p[a].wrapping_add_signed(d[a]));
+            (q.iter().zip(&self.n).all(|(&c, &m)| c < m)).then(|| self.at(q))
+        })
+    }
+
     /// Copies the samples `xs × ys` of plane `z` of the padded grid into `out`, row by row.
     pub fn plane(&self, z: usize, xs: Range<usize>, ys: Range<usize>, out: &mut [L]) {
         let w = xs.len();
@@ -106,6 +132,28 @@ impl<'a, L: Label> Padded<'a, L> {
             row[..x0 - xs.start].fill(self.background);
             row[x0 - xs.start..x1 - xs.start].copy_from_slice(&src[from(x0)..from(x1)]);
             row[x1 - xs.start..].fill(self.background);
+        }
+    }
+
+    /// `kind`, [`few_labels`] of the labels themselves, as it is of their keys: the keys order
+    /// two labels unlike the labels only when the larger is the background, which then plays
+    /// empty. (Comparing labels is cheaper than comparing keys, and one or two labels is most
+    /// cubes with a surface.)
+    #[inline]
+    pub fn by_key(&self, labels: &[L; 8], kind: Kind) -> Kind {
+        match kind {
+            Kind::Binary { background, case } => {
+                let other = case.trailing_zeros() as usize;
+                if self.key(labels[other]) < self.key(labels[usize::from(background)]) {
+                    Kind::Binary {
+                        background: other as u8,
+                        case: !case,
+                    }
+                } else {
+                    kind
+                }
+            }
+            kind => kind,
         }
     }
 
@@ -228,7 +276,9 @@ impl Ids {
 }
 
 /// The vertex in `slot` (see [`Ids`]), made by `make` if it has none yet.
-#[inline]
+// Always inlined: a cube's few vertex lookups are most of a surface cube's work, and the call
+// around one costs as much as the lookup.
+#[inline(always)]
 fn shared(
     (slot, since): (&mut u32, u32),
     make: impl FnOnce() -> Result<u32, Error>,
@@ -279,7 +329,7 @@ impl<L> Out<'_, L> {
 
     /// A new vertex at the midpoint of cube edge `e` of `cube`.
     fn edge_vertex(&mut self, cube: [usize; 3], e: u8) -> Result<u32, Error> {
-        let id = self.vertex(cube, Local::Edge(e).quarters())?;
+        let id = self.vertex(cube, EDGE_QUARTERS[usize::from(e)])?;
         if let Some(edges) = &mut self.edges {
             let [x, y, z] = edge_lower(cube, e);
             // The padded grid's sizes fit in u32 (its vertex ids do).
@@ -391,10 +441,9 @@ pub(super) fn sweep<L: Label>(
                         vertex: out.atlas.positions.len() as u32,
                     });
                 }
-                let keys = labels.map(|l| grid.key(l));
-                let (kind, built) = match few_labels(&keys) {
-                    Some(kind) => (kind, &[][..]),
-                    None => patterns.get(&keys),
+                let (kind, built) = match few_labels(&labels) {
+                    Some(kind) => (grid.by_key(&labels, kind), &[][..]),
+                    None => patterns.get(&labels.map(|l| grid.key(l))),
                 };
                 match kind {
                     Kind::Uniform => {}
@@ -591,6 +640,17 @@ fn edge_lower(cube: [usize; 3], e: u8) -> [usize; 3] {
     let o = EDGE_LOWER[usize::from(e)];
     [cube[0] + o[0], cube[1] + o[1], cube[2] + o[2]]
 }
+
+/// Each cube edge's midpoint, in quarters of a side from the cube's lower corner.
+const EDGE_QUARTERS: [[i32; 3]; 12] = {
+    let mut out = [[0; 3]; 12];
+    let mut e = 0;
+    while e < 12 {
+        out[e] = Local::Edge(e as u8).quarters();
+        e += 1;
+    }
+    out
+};
 
 /// Each cube edge's lower end, from the cube's lower corner.
 const EDGE_LOWER: [[usize; 3]; 12] = {
