@@ -825,16 +825,26 @@ mod tests {
             allow_wrong_side: true,
             ..params
         };
-        let block = extract_block(&volume, [0; 3], v.dims, [0..19, 0..19, 0..19], &adaptive).unwrap();
+        let block =
+            extract_block(&volume, [0; 3], v.dims, [0..19, 0..19, 0..19], &adaptive).unwrap();
         write_shard(&path, &block, &Settings::from(&adaptive)).unwrap();
         let (back, settings) = read_shard(&path).unwrap();
         assert_eq!((back, settings), (block, Settings::from(&adaptive)));
         assert_eq!(settings.params().max_box, Some(4));
         assert!(settings.params().allow_wrong_side);
         for other in [
-            Params { max_box: Some(8), ..adaptive },
-            Params { max_box: None, ..adaptive },
-            Params { allow_wrong_side: false, ..adaptive },
+            Params {
+                max_box: Some(8),
+                ..adaptive
+            },
+            Params {
+                max_box: None,
+                ..adaptive
+            },
+            Params {
+                allow_wrong_side: false,
+                ..adaptive
+            },
         ] {
             assert_ne!(Settings::from(&other), settings);
         }
@@ -853,7 +863,11 @@ mod tests {
         assert!(Settings::from_json(&v).unwrap_err().contains("max_box 3"));
         v["max_box"] = json!(16);
         v["allow_wrong_side"] = json!("yes");
-        assert!(Settings::from_json(&v).unwrap_err().contains("allow_wrong_side"));
+        assert!(
+            Settings::from_json(&v)
+                .unwrap_err()
+                .contains("allow_wrong_side")
+        );
     }
 
     /// `path` rewritten as NumPy writes `np.asfortranarray` arrays: every `(n, 3)` array in
