@@ -124,15 +124,6 @@ impl Sink for Mesh {
     push_to_columns!();
 
     fn expect(&mut self, vertices: usize, triangles: usize) {
-        // Reserve with a quarter to spare, and only when the hint outgrows the capacity, so the
-        // buffers are reallocated a few times at most and never doubled past need.
-        fn grow<T>(v: &mut Vec<T>, more: usize) {
-            // A hint, extrapolated from a volume's header: one the allocator refuses is dropped
-            // (the pushes grow the buffers as they need), rather than aborting the process.
-            if v.capacity() - v.len() < more {
-                let _ = v.try_reserve_exact(more.saturating_add(more / 4));
-            }
-        }
         grow(&mut self.positions, vertices);
         if !self.normals.is_empty() {
             grow(&mut self.normals, vertices);
@@ -141,6 +132,17 @@ impl Sink for Mesh {
             grow(&mut self.values, vertices);
         }
         grow(&mut self.triangles, triangles);
+    }
+}
+
+/// Room for `more` items past `v`'s length, for a [`Sink::expect`] hint: reserved with a quarter
+/// to spare, and only when the hint outgrows the capacity, so the buffers are reallocated a few
+/// times at most and never doubled past need. A hint is extrapolated from a volume's header: one
+/// the allocator refuses is dropped (the pushes grow the buffers as they need), rather than
+/// aborting the process.
+pub(crate) fn grow<T>(v: &mut Vec<T>, more: usize) {
+    if v.capacity() - v.len() < more {
+        let _ = v.try_reserve_exact(more.saturating_add(more / 4));
     }
 }
 

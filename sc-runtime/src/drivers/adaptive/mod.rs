@@ -133,6 +133,7 @@ fn run<T: Scalar>(
         &mut rec,
     )?;
     drop(scratch);
+    rec.settle();
     let largest = params.max_box.unwrap_or(LARGEST_BOX);
     let levels = largest.ilog2() as usize;
     if !has_cubes(dims) || levels == 0 {
@@ -163,7 +164,7 @@ fn run<T: Scalar>(
         values: false,
         ..*params
     };
-    let mut merged = Recorded::new(grid);
+    let mut merged = Recorded::without_positions(grid);
     let mut scratch = OwnedScratch::new(dims)?;
     sweep_at(
         &Binary::new(&embedded),
@@ -174,6 +175,7 @@ fn run<T: Scalar>(
         &mut merged,
     )?;
     drop(scratch);
+    merged.settle();
     let grid = Grid::new(volume, at, grid, params.iso, &rec);
     let lattice = grid.decide(levels, &tolerance);
     let units = match lattice.first() {

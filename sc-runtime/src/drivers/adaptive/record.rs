@@ -3,6 +3,7 @@
 
 use alloc::vec::Vec;
 
+use crate::mesh::grow;
 use crate::{Mesh, Sink};
 
 /// A mesh being swept, and each vertex's edge key and each triangle's cube key
@@ -12,6 +13,9 @@ pub(super) struct Recorded {
     pub edges: Vec<u64>,
     pub cubes: Vec<u64>,
     pub dims: [usize; 3],
+    /// Whether positions (and normals) are kept: embedded mode's sweep, read for its merges
+    /// only, needs the edges and triangles alone.
+    positions: bool,
 }
 
 impl Recorded {
@@ -21,7 +25,26 @@ impl Recorded {
             edges: Vec::new(),
             cubes: Vec::new(),
             dims,
+            positions: true,
         }
+    }
+
+    /// A record of the edges and triangles only.
+    pub fn without_positions(dims: [usize; 3]) -> Recorded {
+        Recorded {
+            positions: false,
+            ..Recorded::new(dims)
+        }
+    }
+
+    /// Gives back the room the sweep's growing lists left spare: the records are held while
+    /// every box is decided, the peak of adaptive mode's memory.
+    pub fn settle(&mut self) {
+        self.mesh.positions.shrink_to_fit();
+        self.mesh.normals.shrink_to_fit();
+        self.mesh.triangles.shrink_to_fit();
+        self.edges.shrink_to_fit();
+        self.cubes.shrink_to_fit();
     }
 
     pub fn point_key(&self, p: [usize; 3]) -> u64 {
@@ -33,7 +56,9 @@ impl Sink for Recorded {
     fn vertex(&mut self, position: [f32; 3], normal: Option<[f32; 3]>) {
         // Every vertex of the sweep comes with its edge; one without would have no key.
         self.edges.push(u64::MAX);
-        self.mesh.vertex(position, normal);
+        if self.positions {
+            self.mesh.vertex(position, normal);
+        }
     }
 
     fn edge_vertex(
@@ -44,7 +69,9 @@ impl Sink for Recorded {
         normal: Option<[f32; 3]>,
     ) {
         self.edges.push(3 * self.point_key(lower) + axis as u64);
-        self.mesh.vertex(position, normal);
+        if self.positions {
+            self.mesh.vertex(position, normal);
+        }
     }
 
     fn vertex_value(&mut self, value: f32) {
@@ -54,6 +81,13 @@ impl Sink for Recorded {
     fn triangle(&mut self, triangle: [u32; 3]) {
         self.cubes.push(u64::MAX);
         self.mesh.triangle(triangle);
+    }
+
+    fn expect(&mut self, vertices: usize, triangles: usize) {
+        self.mesh
+            .expect(if self.positions { vertices } else { 0 }, triangles);
+        grow(&mut self.edges, vertices);
+        grow(&mut self.cubes, triangles);
     }
 
     fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {
