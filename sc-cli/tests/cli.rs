@@ -571,6 +571,26 @@ fn max_error_trades_triangles_for_a_bound() {
     assert!(!dir.path().join("bad.ply").exists());
 }
 
+/// The `--stats-json` of extracting the 40³ torus with `args` into `dir`, which must succeed.
+fn torus_stats(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
+    let json = dir.join("stats.json");
+    let run = Command::cargo_bin("skelclimb")
+        .unwrap()
+        .args(["extract", "--demo", "torus", "--size", "40", "-q", "-o"])
+        .arg(dir.join("torus.ply"))
+        .arg("--stats-json")
+        .arg(&json)
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap()
+}
+
 /// `--max-box` caps adaptive mode's boxes: more triangles with smaller boxes, never more than
 /// Steps 1–3; refused outside adaptive mode and for a side that is not a power of two up to
 /// 16, before anything is written.
@@ -578,25 +598,9 @@ fn max_error_trades_triangles_for_a_bound() {
 fn max_box_caps_adaptive_boxes_and_is_refused_elsewhere() {
     let dir = tempfile::tempdir().unwrap();
     let triangles = |args: &[&str]| {
-        let stats = dir.path().join("stats.json");
-        let out = dir.path().join("torus.ply");
-        let mut all = vec!["extract", "--demo", "torus", "--size", "40", "-q", "-o"];
-        all.push(out.to_str().unwrap());
-        all.extend_from_slice(&["--stats-json", stats.to_str().unwrap()]);
-        all.extend_from_slice(args);
-        let run = Command::cargo_bin("skelclimb")
+        torus_stats(dir.path(), args)["result"]["triangles"]
+            .as_u64()
             .unwrap()
-            .args(&all)
-            .output()
-            .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let json: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(stats).unwrap()).unwrap();
-        json["result"]["triangles"].as_u64().unwrap()
     };
     let steps123 = triangles(&["--mode", "steps123"]);
     let small = triangles(&["--mode", "adaptive", "--max-box", "2"]);
@@ -632,25 +636,7 @@ fn max_box_caps_adaptive_boxes_and_is_refused_elsewhere() {
 #[test]
 fn adaptive_stats_report_the_distance_to_steps123_within_the_bound() {
     let dir = tempfile::tempdir().unwrap();
-    let stats = |args: &[&str]| {
-        let json = dir.path().join("stats.json");
-        let out = dir.path().join("torus.ply");
-        let run = Command::cargo_bin("skelclimb")
-            .unwrap()
-            .args(["extract", "--demo", "torus", "--size", "40", "-q", "-o"])
-            .arg(&out)
-            .arg("--stats-json")
-            .arg(&json)
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&std::fs::read(json).unwrap()).unwrap()
-    };
+    let stats = |args: &[&str]| torus_stats(dir.path(), args);
     for (bound, units) in [("0.3", "voxels"), ("0.8", "voxels"), ("0.01", "world")] {
         let j = stats(&[
             "--mode",

@@ -122,18 +122,7 @@ fn run<T: Scalar>(
         max_box: None,
         ..*params
     };
-    let mut rec = Recorded::new(grid);
-    let mut scratch = OwnedScratch::new(dims)?;
-    sweep_at(
-        &Binary::new(&steps123),
-        volume,
-        at,
-        &steps123,
-        scratch.lend(),
-        &mut rec,
-    )?;
-    drop(scratch);
-    rec.settle();
+    let rec = record(volume, at, &steps123, Recorded::new(grid))?;
     let largest = params.max_box.unwrap_or(LARGEST_BOX);
     let levels = largest.ilog2() as usize;
     if !has_cubes(dims) || levels == 0 {
@@ -164,18 +153,7 @@ fn run<T: Scalar>(
         values: false,
         ..*params
     };
-    let mut merged = Recorded::without_positions(grid);
-    let mut scratch = OwnedScratch::new(dims)?;
-    sweep_at(
-        &Binary::new(&embedded),
-        volume,
-        at,
-        &embedded,
-        scratch.lend(),
-        &mut merged,
-    )?;
-    drop(scratch);
-    merged.settle();
+    let merged = record(volume, at, &embedded, Recorded::without_positions(grid))?;
     let grid = Grid::new(volume, at, grid, params.iso, &rec);
     let lattice = grid.decide(levels, &tolerance);
     let units = match lattice.first() {
@@ -200,6 +178,27 @@ fn run<T: Scalar>(
         owners,
         merges,
     })
+}
+
+/// The sweep of `volume` (at global index `at`) under `params` into `rec`, its spare room given
+/// back.
+fn record<T: Scalar>(
+    volume: &Volume<'_, T>,
+    at: [usize; 3],
+    params: &Params,
+    mut rec: Recorded,
+) -> Result<Recorded, Error> {
+    let mut scratch = OwnedScratch::new(volume.dims())?;
+    sweep_at(
+        &Binary::new(params),
+        volume,
+        at,
+        params,
+        scratch.lend(),
+        &mut rec,
+    )?;
+    rec.settle();
+    Ok(rec)
 }
 
 /// A box on the lattice of its size: whether it may replace its cubes.
