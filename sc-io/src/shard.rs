@@ -21,6 +21,12 @@
 //! coordinates are, and each shard's file and cubes; [`merge`] checks every shard against it, so
 //! a missing, damaged, foreign or duplicated shard is reported by file name instead of giving a
 //! wrong mesh.
+//!
+//! Manifests and shards name their `kind`: `surface` for the iso surfaces above (the kind of
+//! files that name none, written before label shards existed), `labels` for a label volume's
+//! atlas ([`crate::labels::extract_shards`]; its shards hold `pairs` instead of `normals`). The envelope —
+//! manifest, header, cover and entry checks — is this module's for both, through
+//! [`ShardSettings`].
 
 use std::io::{self, BufReader, Read, Seek, Write};
 use std::ops::Range;
@@ -45,6 +51,29 @@ const SHARD_FORMAT: &str = "skelclimb-shard";
 const VERSION: u64 = 1;
 /// The manifest's file name inside a shard directory.
 pub const MANIFEST_NAME: &str = "manifest.json";
+/// The kind of files written before kinds were named.
+const SURFACE: &str = "surface";
+
+/// What one kind of shards records of how they were made: every shard of a manifest must have
+/// been made with its manifest's settings.
+pub trait ShardSettings: Clone + PartialEq + std::fmt::Debug + Sized {
+    /// The `kind` field of manifests and shard headers.
+    const KIND: &'static str;
+    /// The settings as JSON.
+    fn to_json(&self) -> Value;
+    /// The settings `v` holds, or what is wrong with them.
+    fn from_json(v: &Value) -> std::result::Result<Self, String>;
+    /// The part of the settings each shard records, which is what it is checked by (the
+    /// manifest may record more, that only the merge uses).
+    fn in_shards(&self) -> Self {
+        self.clone()
+    }
+    /// Samples along x, y, z of the grid whose cubes the shards own and name by key (the
+    /// volume's, unless the meshing pads it).
+    fn key_grid(&self, grid: [usize; 3]) -> [usize; 3] {
+        grid
+    }
+}
 
 /// What every block of one mesh must share besides the grid: the extractor's parameters (the
 /// case tables excepted, which a file cannot name). A type of its own rather than [`Params`]
@@ -99,8 +128,12 @@ impl Settings {
             ..Params::new(self.iso)
         }
     }
+}
 
-    fn to_json(self) -> Value {
+impl ShardSettings for Settings {
+    const KIND: &'static str = SURFACE;
+
+    fn to_json(&self) -> Value {
         json!({
             "iso": self.iso,
             "mode": self.mode.name(),
@@ -113,8 +146,8 @@ impl Settings {
         })
     }
 
-    /// The settings `v` holds, or what is wrong with them: an unknown mode or units name lists
-    /// the valid ones, and every number must be one the extractor can use ([`limits`]).
+    /// An unknown mode or units name lists the valid ones, and every number must be one the
+    /// extractor can use ([`limits`]).
     fn from_json(v: &Value) -> std::result::Result<Settings, String> {
         let mode = v["mode"]
             .as_str()
@@ -171,7 +204,7 @@ impl Settings {
 }
 
 /// Three numbers at `v`, each a coordinate the extractor can use ([`limits::triple`]).
-fn coordinates(v: &Value, what: &str) -> std::result::Result<[f64; 3], String> {
+pub(crate) fn coordinates(v: &Value, what: &str) -> std::result::Result<[f64; 3], String> {
     triple(v)
         .ok_or_else(|| format!("{what} {v}: {}", limits::THREE_COORDINATES))
         .and_then(|t| limits::triple(t).map_err(|e| format!("{what} {v}: {e}")))
@@ -234,13 +267,14 @@ impl ShardEntry {
     }
 }
 
-/// A manifest: the grid, the settings, where the coordinates are, and the shards.
+/// A manifest: the grid, the settings, where the coordinates are, and the shards; of iso
+/// surface shards unless `S` says otherwise.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Manifest {
+pub struct Manifest<S = Settings> {
     /// Samples of the whole grid along x, y, z.
     pub grid: [usize; 3],
     /// The extractor's settings, the same for every shard.
-    pub settings: Settings,
+    pub settings: S,
     /// The map from the shards' positions to the mesh's coordinates; identity plus the origin
     /// unless the volume's file rotates it (then [`merge`] places the joined mesh).
     pub world: World,
@@ -259,11 +293,56 @@ impl Manifest {
             shards: Vec::new(),
         }
     }
+}
 
+/// The kind of shards the manifest at `path` lists (`surface` for one that names none), after
+/// checking that it is a manifest this version reads; for a reader to choose how to merge.
+pub fn kind(path: &Path) -> Result<String> {
+    let v = load(path)?;
+    kind_of(&v)
+        .map(str::to_owned)
+        .map_err(|m| Error::file(path, m))
+}
+
+/// The `kind` field of a manifest or shard header.
+fn kind_of(v: &Value) -> std::result::Result<&str, String> {
+    match &v["kind"] {
+        Value::Null => Ok(SURFACE),
+        k => k
+            .as_str()
+            .ok_or_else(|| format!("not a shard manifest: its kind {k} is not a name")),
+    }
+}
+
+/// The manifest at `path` as JSON, if it is one of the version this crate reads.
+fn load(path: &Path) -> Result<Value> {
+    let mut bytes = Vec::new();
+    crate::input::open(path)?
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    let bad = |m: &str| Error::file(path, format!("not a shard manifest: {m}"));
+    let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(&e.to_string()))?;
+    if v["format"] != MANIFEST_FORMAT {
+        return Err(bad(&format!("its format is not {MANIFEST_FORMAT:?}")));
+    }
+    if v["version"] != VERSION {
+        return Err(Error::file(
+            path,
+            format!(
+                "manifest version {} is not the {VERSION} this skelclimb reads",
+                v["version"]
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+impl<S: ShardSettings> Manifest<S> {
     fn to_json(&self) -> Value {
         json!({
             "format": MANIFEST_FORMAT,
             "version": VERSION,
+            "kind": S::KIND,
             "grid": self.grid,
             "settings": self.settings.to_json(),
             "world": {
@@ -286,29 +365,23 @@ impl Manifest {
         AtomicFile::create(path)?.write_with(|out| out.write_all(&text?))
     }
 
-    /// Reads a manifest and checks that its shards are distinct files owning disjoint boxes of
-    /// cubes that together cover the grid.
-    pub fn read(path: &Path) -> Result<Manifest> {
-        let mut bytes = Vec::new();
-        crate::input::open(path)?
-            .read_to_end(&mut bytes)
-            .map_err(|e| Error::io(path, e))?;
+    /// Reads a manifest of shards of this kind and checks that its shards are distinct files
+    /// owning disjoint boxes of cubes that together cover the grid.
+    pub fn read(path: &Path) -> Result<Manifest<S>> {
+        let v = load(path)?;
         let bad = |m: &str| Error::file(path, format!("not a shard manifest: {m}"));
-        let v: Value = serde_json::from_slice(&bytes).map_err(|e| bad(&e.to_string()))?;
-        if v["format"] != MANIFEST_FORMAT {
-            return Err(bad(&format!("its format is not {MANIFEST_FORMAT:?}")));
-        }
-        if v["version"] != VERSION {
+        let kind = kind_of(&v).map_err(|m| Error::file(path, m))?;
+        if kind != S::KIND {
             return Err(Error::file(
                 path,
                 format!(
-                    "manifest version {} is not the {VERSION} this skelclimb reads",
-                    v["version"]
+                    "a manifest of {kind} shards, where {} shards are wanted",
+                    S::KIND
                 ),
             ));
         }
         let grid = usizes(&v["grid"]).ok_or_else(|| bad("no grid"))?;
-        let settings = Settings::from_json(&v["settings"]).map_err(|m| bad(&m))?;
+        let settings = S::from_json(&v["settings"]).map_err(|m| bad(&m))?;
         let world = world_from_json(&v["world"]).map_err(|m| bad(&m))?;
         let shards = v["shards"]
             .as_array()
@@ -330,7 +403,10 @@ impl Manifest {
     /// the message can name the files.
     fn check_cover(&self, path: &Path) -> Result<()> {
         let refuse = |m: String| Err(Error::file(path, m));
-        let cubes = self.grid.map(|n| n.saturating_sub(1));
+        let cubes = self
+            .settings
+            .key_grid(self.grid)
+            .map(|n| n.saturating_sub(1));
         let total = cubes.iter().try_fold(1u64, |n, &c| n.checked_mul(c as u64));
         let Some(total) = total else {
             return refuse(format!(
@@ -518,39 +594,74 @@ fn entry_from_json(v: &Value) -> Option<ShardEntry> {
 
 /// Writes `block`, meshed with `settings`, to the shard file `path`, whole or not at all.
 pub fn write_shard(path: &Path, block: &BlockMesh, settings: &Settings) -> Result<()> {
+    let header = Header {
+        grid: block.grid,
+        settings: *settings,
+        stats: block.stats,
+        covered: block.covered,
+    };
+    write_file(path, &header, |npz| {
+        put(npz, "keys", &[block.keys.len()], &block.keys)?;
+        put(
+            npz,
+            "positions",
+            &[block.positions.len(), 3],
+            block.positions.as_flattened(),
+        )?;
+        put(
+            npz,
+            "normals",
+            &[block.normals.len(), 3],
+            block.normals.as_flattened(),
+        )?;
+        put(
+            npz,
+            "triangles",
+            &[block.triangles.len(), 3],
+            block.triangles.as_flattened(),
+        )?;
+        put(npz, "cubes", &[block.cubes.len()], &block.cubes)
+    })
+}
+
+/// A shard's header besides its format, version and kind: what every kind of share carries.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Header<S> {
+    /// Samples of the whole grid.
+    pub grid: [usize; 3],
+    /// How the share was made ([`ShardSettings::in_shards`] of the manifest's).
+    pub settings: S,
+    /// The counts of the owned cubes.
+    pub stats: Stats,
+    /// Cubes owned.
+    pub covered: u64,
+}
+
+/// The npz archive a shard is written into.
+pub(crate) type ShardWriter<'a, 'b> = NpzWriter<&'a mut io::BufWriter<crate::atomic::Output<'b>>>;
+
+/// Writes a shard of `header`'s kind to `path`, whole or not at all: the header, then the arrays
+/// `arrays` [`put`]s.
+pub(crate) fn write_file<S: ShardSettings>(
+    path: &Path,
+    header: &Header<S>,
+    arrays: impl FnOnce(&mut ShardWriter<'_, '_>) -> io::Result<()>,
+) -> Result<()> {
     let header = json!({
         "format": SHARD_FORMAT,
         "version": VERSION,
-        "grid": block.grid,
-        "settings": settings.to_json(),
-        "stats": stats_json(&block.stats),
-        "covered": block.covered,
+        "kind": S::KIND,
+        "grid": header.grid,
+        "settings": header.settings.in_shards().to_json(),
+        "stats": stats_json(&header.stats),
+        "covered": header.covered,
     });
     let header = serde_json::to_vec(&header).map_err(io::Error::other);
     AtomicFile::create(path)?.write_with(|out| {
         let header = header?;
         let mut npz = NpzWriter::new(out);
         put(&mut npz, "header", &[header.len()], &header)?;
-        put(&mut npz, "keys", &[block.keys.len()], &block.keys)?;
-        put(
-            &mut npz,
-            "positions",
-            &[block.positions.len(), 3],
-            block.positions.as_flattened(),
-        )?;
-        put(
-            &mut npz,
-            "normals",
-            &[block.normals.len(), 3],
-            block.normals.as_flattened(),
-        )?;
-        put(
-            &mut npz,
-            "triangles",
-            &[block.triangles.len(), 3],
-            block.triangles.as_flattened(),
-        )?;
-        put(&mut npz, "cubes", &[block.cubes.len()], &block.cubes)?;
+        arrays(&mut npz)?;
         npz.zip_writer().finish().map_err(io::Error::other)?;
         Ok(())
     })
@@ -575,7 +686,12 @@ fn stats_from_json(v: &Value) -> Option<Stats> {
     Some(Stats::from_array(counts))
 }
 
-fn put<T, W>(npz: &mut NpzWriter<W>, name: &str, shape: &[usize], data: &[T]) -> io::Result<()>
+pub(crate) fn put<T, W>(
+    npz: &mut NpzWriter<W>,
+    name: &str,
+    shape: &[usize],
+    data: &[T],
+) -> io::Result<()>
 where
     T: npyz::AutoSerialize + Copy,
     W: Write + Seek,
@@ -596,45 +712,96 @@ where
 /// Reads a shard: its block mesh and the settings it was made with. A damaged file is an error
 /// naming it, never a wrong mesh.
 pub fn read_shard(path: &Path) -> Result<(BlockMesh, Settings)> {
-    let bad = |m: &str| Error::file(path, format!("not a readable shard: {m}"));
-    let file = crate::input::open(path)?;
-    let limit = file.metadata().map_err(|e| Error::io(path, e))?.len();
-    let mut npz = NpzArchive::new(BufReader::new(file)).map_err(|e| bad(&e.to_string()))?;
-    let header: Vec<u8> = array(&mut npz, "header", 1, limit).map_err(|m| bad(&m))?;
-    let header: Value =
-        serde_json::from_slice(&header).map_err(|e| bad(&format!("header: {e}")))?;
-    if header["format"] != SHARD_FORMAT {
-        return Err(bad(&format!("its header's format is not {SHARD_FORMAT:?}")));
-    }
-    if header["version"] != VERSION {
-        return Err(bad(&format!(
-            "shard version {} is not the {VERSION} this skelclimb reads",
-            header["version"]
-        )));
-    }
-    let settings = Settings::from_json(&header["settings"]).map_err(|m| bad(&m))?;
+    let (mut file, header) = ShardFile::open::<Settings>(path)?;
     let block = BlockMesh {
-        grid: usizes(&header["grid"]).ok_or_else(|| bad("no grid"))?,
-        stats: stats_from_json(&header["stats"]).ok_or_else(|| bad("no counts"))?,
-        covered: header["covered"]
-            .as_u64()
-            .ok_or_else(|| bad("no cube count"))?,
-        keys: array(&mut npz, "keys", 1, limit).map_err(|m| bad(&m))?,
-        positions: rows(array(&mut npz, "positions", 3, limit).map_err(|m| bad(&m))?),
-        normals: rows(array(&mut npz, "normals", 3, limit).map_err(|m| bad(&m))?),
-        triangles: rows(array(&mut npz, "triangles", 3, limit).map_err(|m| bad(&m))?),
-        cubes: array(&mut npz, "cubes", 1, limit).map_err(|m| bad(&m))?,
+        grid: header.grid,
+        stats: header.stats,
+        covered: header.covered,
+        keys: file.array("keys", 1)?,
+        positions: rows(file.array("positions", 3)?),
+        normals: rows(file.array("normals", 3)?),
+        triangles: rows(file.array("triangles", 3)?),
+        cubes: file.array("cubes", 1)?,
     };
-    block.check().map_err(|e| bad(&e.to_string()))?;
-    for (name, rows) in [("positions", &block.positions), ("normals", &block.normals)] {
-        if let Some(i) = rows.iter().position(|r| !r.iter().all(|c| c.is_finite())) {
-            return Err(bad(&format!(
-                "{name} row {i} is {:?}: not finite numbers",
-                rows[i]
+    block.check().map_err(|e| file.bad(&e.to_string()))?;
+    file.check_finite("positions", &block.positions)?;
+    file.check_finite("normals", &block.normals)?;
+    Ok((block, header.settings))
+}
+
+/// A shard opened for reading its arrays; errors name its file.
+pub(crate) struct ShardFile<'p> {
+    path: &'p Path,
+    npz: NpzArchive<BufReader<std::fs::File>>,
+    /// The file's length, which no stored entry can pass.
+    limit: u64,
+}
+
+impl<'p> ShardFile<'p> {
+    /// Opens the shard at `path` and reads its header, which must be of kind `S`.
+    pub(crate) fn open<S: ShardSettings>(path: &'p Path) -> Result<(Self, Header<S>)> {
+        let file = crate::input::open(path)?;
+        let limit = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        let npz = NpzArchive::new(BufReader::new(file))
+            .map_err(|e| Error::file(path, format!("not a readable shard: {e}")))?;
+        let mut shard = ShardFile { path, npz, limit };
+        let header: Vec<u8> = shard.array("header", 1)?;
+        let header: Value =
+            serde_json::from_slice(&header).map_err(|e| shard.bad(&format!("header: {e}")))?;
+        if header["format"] != SHARD_FORMAT {
+            return Err(shard.bad(&format!("its header's format is not {SHARD_FORMAT:?}")));
+        }
+        if header["version"] != VERSION {
+            return Err(shard.bad(&format!(
+                "shard version {} is not the {VERSION} this skelclimb reads",
+                header["version"]
             )));
         }
+        let kind = kind_of(&header).map_err(|m| shard.bad(&m))?;
+        if kind != S::KIND {
+            return Err(Error::file(
+                path,
+                format!(
+                    "a shard of {kind}, where the manifest lists {} shards",
+                    S::KIND
+                ),
+            ));
+        }
+        let header = Header {
+            grid: usizes(&header["grid"]).ok_or_else(|| shard.bad("no grid"))?,
+            settings: S::from_json(&header["settings"]).map_err(|m| shard.bad(&m))?,
+            stats: stats_from_json(&header["stats"]).ok_or_else(|| shard.bad("no counts"))?,
+            covered: header["covered"]
+                .as_u64()
+                .ok_or_else(|| shard.bad("no cube count"))?,
+        };
+        Ok((shard, header))
     }
-    Ok((block, settings))
+
+    /// The error that the file is not a readable shard, for `why`.
+    pub(crate) fn bad(&self, why: &str) -> Error {
+        Error::file(self.path, format!("not a readable shard: {why}"))
+    }
+
+    /// The array `name` ([`array`]).
+    pub(crate) fn array<T: npyz::Deserialize + Copy>(
+        &mut self,
+        name: &str,
+        width: usize,
+    ) -> Result<Vec<T>> {
+        array(&mut self.npz, name, width, self.limit).map_err(|m| self.bad(&m))
+    }
+
+    /// Refuses rows that are not all finite numbers.
+    pub(crate) fn check_finite(&self, name: &str, rows: &[[f32; 3]]) -> Result<()> {
+        match rows.iter().position(|r| !r.iter().all(|c| c.is_finite())) {
+            Some(i) => Err(self.bad(&format!(
+                "{name} row {i} is {:?}: not finite numbers",
+                rows[i]
+            ))),
+            None => Ok(()),
+        }
+    }
 }
 
 /// The array `name`, of shape `(n,)` for `width` 1 or `(n, width)` otherwise, flattened.
@@ -692,7 +859,7 @@ fn array<T: npyz::Deserialize + Copy, R: Read + Seek>(
     })
 }
 
-fn rows<T: Copy>(flat: Vec<T>) -> Vec<[T; 3]> {
+pub(crate) fn rows<T: Copy>(flat: Vec<T>) -> Vec<[T; 3]> {
     flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
 }
 
@@ -750,40 +917,72 @@ fn join(a: BlockMesh, b: BlockMesh, manifest: &Path) -> Result<BlockMesh> {
 /// Reads the shard `entry` names and checks that it is that block of that mesh.
 fn read_checked(path: &Path, entry: &ShardEntry, manifest: &Manifest) -> Result<BlockMesh> {
     let (block, settings) = read_shard(path)?;
+    let header = Header {
+        grid: block.grid,
+        settings,
+        stats: block.stats,
+        covered: block.covered,
+    };
+    let counts = [block.keys.len(), block.triangles.len()].map(|n| n as u64);
+    check_entry(path, entry, manifest, &header, counts, &block.cubes)?;
+    Ok(block)
+}
+
+/// Checks that the shard at `path`, with `header`, `counts` (vertices, triangles) and owning
+/// cubes `cubes`, is the block `entry` of the manifest's mesh.
+pub(crate) fn check_entry<S: ShardSettings>(
+    path: &Path,
+    entry: &ShardEntry,
+    manifest: &Manifest<S>,
+    header: &Header<S>,
+    counts: [u64; 2],
+    cubes: &[u64],
+) -> Result<()> {
     let refuse = |m: String| Err(Error::file(path, m));
-    if block.grid != manifest.grid {
+    if header.grid != manifest.grid {
         return refuse(format!(
             "a shard of a {:?} grid, but the manifest's grid is {:?}",
-            block.grid, manifest.grid
+            header.grid, manifest.grid
         ));
     }
-    if settings != manifest.settings {
+    let wanted = manifest.settings.in_shards();
+    if header.settings != wanted {
         return refuse(format!(
             "made with other settings than the manifest's ({} rather than {})",
-            settings.to_json(),
-            manifest.settings.to_json()
+            header.settings.to_json(),
+            wanted.to_json()
         ));
     }
-    let [nx, ny, _] = manifest.grid.map(|n| n as u64);
+    let [nx, ny, _] = manifest.settings.key_grid(manifest.grid).map(|n| n as u64);
     let inside = |key: u64| {
         let at = [key % nx, key / nx % ny, key / nx / ny];
         (0..3).all(|d| entry.cubes[d].contains(&(at[d] as usize)))
     };
-    let counts = [block.keys.len() as u64, block.triangles.len() as u64];
-    if block.covered != entry.count()
+    if header.covered != entry.count()
         || counts != [entry.vertices, entry.triangles]
-        || !block.cubes.iter().all(|&c| inside(c))
+        || !cubes.iter().all(|&c| inside(c))
     {
         return refuse(format!(
             "not the block of cubes {:?} the manifest lists under this name",
             entry.cubes
         ));
     }
-    Ok(block)
+    Ok(())
+}
+
+/// The blocks of up to `block` cubes per axis that tile a grid of `cubes` cubes per axis, x
+/// fastest: the blocks `extract --shards` writes.
+pub(crate) fn blocks(cubes: [usize; 3], block: usize) -> impl Iterator<Item = [Range<usize>; 3]> {
+    let block = block.max(1);
+    let starts = move |d: usize| (0..cubes[d]).step_by(block);
+    let along = move |d: usize, s: usize| s..(s + block).min(cubes[d]);
+    starts(2).flat_map(move |z| {
+        starts(1).flat_map(move |y| starts(0).map(move |x| [along(0, x), along(1, y), along(2, z)]))
+    })
 }
 
 /// Where the shard `entry` of the manifest at `manifest_path` is.
-fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
+pub(crate) fn shard_path(manifest_path: &Path, entry: &ShardEntry) -> PathBuf {
     manifest_path
         .parent()
         .unwrap_or(Path::new(""))

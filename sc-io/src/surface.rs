@@ -12,9 +12,9 @@ use crate::distance::{self, Distance};
 use crate::error::Result;
 use crate::progress::{Progress, Silent};
 use crate::read::stream::Stream;
-use crate::shard::{MANIFEST_NAME, Manifest, ShardEntry, write_shard};
+use crate::shard::{MANIFEST_NAME, Manifest, ShardEntry, blocks, write_shard};
 use crate::space::{Coordinates, World};
-use crate::volume::{Grid, Range, Sample};
+use crate::volume::{Grid, Range, Sample, cut};
 use crate::{with_dtype, with_samples};
 
 /// What to extract.
@@ -166,19 +166,14 @@ pub fn extract_shards(
     let mut manifest = Manifest::new(grid.dims, &params);
     manifest.world = world;
     std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
-    let starts = |d: usize| (0..grid.dims[d].saturating_sub(1)).step_by(block.max(1));
-    let cubes_along = |d: usize, s: usize| s..(s + block).min(grid.dims[d] - 1);
-    progress.phase("meshing", starts(2).len() as u64);
-    for z in starts(2) {
-        for y in starts(1) {
-            for x in starts(0) {
-                let cubes = [cubes_along(0, x), cubes_along(1, y), cubes_along(2, z)];
-                let mesh = with_samples!(&grid.samples, v => block_of(v, grid.dims, cubes.clone(), &params))?;
-                let file = ShardEntry::file_name(&cubes);
-                write_shard(&dir.join(&file), &mesh, &manifest.settings)?;
-                manifest.shards.push(ShardEntry::new(file, cubes, &mesh));
-            }
-        }
+    let cubes = grid.dims.map(|n| n.saturating_sub(1));
+    progress.phase("meshing", blocks(cubes, block).count() as u64);
+    for cubes in blocks(cubes, block) {
+        let mesh =
+            with_samples!(&grid.samples, v => block_of(v, grid.dims, cubes.clone(), &params))?;
+        let file = ShardEntry::file_name(&cubes);
+        write_shard(&dir.join(&file), &mesh, &manifest.settings)?;
+        manifest.shards.push(ShardEntry::new(file, cubes, &mesh));
         progress.inc(1);
     }
     manifest.write(&dir.join(MANIFEST_NAME))?;
@@ -193,14 +188,7 @@ fn block_of<T: Sample>(
     params: &Params,
 ) -> Result<sc_runtime::BlockMesh> {
     let need = block_samples(dims, cubes.clone(), params)?;
-    let [nx, ny, _] = dims;
-    let mut samples = Vec::with_capacity(need.iter().map(|r| r.len()).product());
-    for z in need[2].clone() {
-        for y in need[1].clone() {
-            let row = (z * ny + y) * nx;
-            samples.extend_from_slice(&data[row + need[0].start..row + need[0].end]);
-        }
-    }
+    let samples = cut(data, dims, &need);
     let box_dims = need.clone().map(|r| r.len());
     let volume = Volume::new(&samples, box_dims)?;
     Ok(extract_block(

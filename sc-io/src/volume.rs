@@ -454,6 +454,23 @@ fn pad_value<T: Sample>(v: &[T], stored_iso: f64) -> Option<T> {
         .or_else(|| T::largest_below(stored_iso))
 }
 
+/// The samples of the box `at` (per axis) of a volume of `dims` samples stored x fastest, as a
+/// volume of their own: a block's samples, copied out for meshing it alone.
+pub(crate) fn cut<T: Copy>(
+    v: &[T],
+    [nx, ny, _]: [usize; 3],
+    at: &[std::ops::Range<usize>; 3],
+) -> Vec<T> {
+    let mut out = Vec::with_capacity(at.iter().map(|r| r.len()).product());
+    for z in at[2].clone() {
+        for y in at[1].clone() {
+            let row = (z * ny + y) * nx;
+            out.extend_from_slice(&v[row + at[0].start..row + at[0].end]);
+        }
+    }
+    out
+}
+
 fn padded<T: Sample>(v: &[T], [nx, ny, nz]: [usize; 3], fill: T) -> Vec<T> {
     let (px, py) = (nx + 2, ny + 2);
     let mut out = vec![fill; px * py * (nz + 2)];

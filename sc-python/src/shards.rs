@@ -77,7 +77,7 @@ pub fn write_manifest(
     let path = directory.join(MANIFEST_NAME);
     manifest.write(&path).map_err(errors::io)?;
     // Read back: the same checks `merge` makes, now rather than on another machine later.
-    Manifest::read(&path).map_err(errors::io)?;
+    Manifest::<Settings>::read(&path).map_err(errors::io)?;
     Ok(path)
 }
 
