@@ -55,6 +55,28 @@ impl Selection {
     }
 }
 
+/// `all`, or the ranges as [`Selection::parse`] reads them (`1,5,17-20`).
+impl std::fmt::Display for Selection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Selection::All => f.write_str("all"),
+            Selection::Only(ranges) => {
+                let parts: Vec<String> = ranges.iter().map(range_text).collect();
+                f.write_str(&parts.join(","))
+            }
+        }
+    }
+}
+
+/// `5` or `17-20`.
+fn range_text(r: &RangeInclusive<u64>) -> String {
+    if r.start() == r.end() {
+        r.start().to_string()
+    } else {
+        format!("{}-{}", r.start(), r.end())
+    }
+}
+
 /// What to mesh in a label volume.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LabelRequest {
@@ -192,8 +214,29 @@ pub(super) fn select<L>(
 where
     L: Sample + TryInto<i64>,
 {
-    let present = atlas.labels(background);
-    let id = |l: L| -> Option<u64> { l.try_into().ok().and_then(|v: i64| u64::try_from(v).ok()) };
+    let chosen = chosen(&atlas.labels(background), request)?;
+    let meshes = atlas
+        .meshes(&chosen, request.normals)
+        .into_iter()
+        .filter_map(|(l, mesh)| Some((id(l)?, mesh)))
+        .collect();
+    Ok(LabelMeshes {
+        meshes,
+        stats: atlas.stats,
+    })
+}
+
+/// A label's id, if it is one (0 or more).
+fn id<L: TryInto<i64>>(l: L) -> Option<u64> {
+    l.try_into().ok().and_then(|v: i64| u64::try_from(v).ok())
+}
+
+/// The labels of `present` (ascending, without the background) that `request` selects; refuses
+/// a selection of labels not present, negative labels, and none present.
+pub(super) fn chosen<L>(present: &[L], request: &LabelRequest) -> Result<Vec<L>>
+where
+    L: Sample + TryInto<i64>,
+{
     if let Some(&negative) = present.iter().find(|&&l| id(l).is_none()) {
         return Err(Error::Usage(format!(
             "--labels: the volume holds the label {negative:?}; label ids are whole numbers, 0 or more"
@@ -212,13 +255,7 @@ where
                     .iter()
                     .any(|&l| id(l).is_some_and(|i| r.contains(&i)))
             })
-            .map(|r| {
-                if r.start() == r.end() {
-                    r.start().to_string()
-                } else {
-                    format!("{}-{}", r.start(), r.end())
-                }
-            })
+            .map(range_text)
             .collect();
         if !missing.is_empty() {
             let some: Vec<String> = present
@@ -245,15 +282,7 @@ where
             request.background
         )));
     }
-    let meshes = atlas
-        .meshes(&chosen, request.normals)
-        .into_iter()
-        .filter_map(|(l, mesh)| Some((id(l)?, mesh)))
-        .collect();
-    Ok(LabelMeshes {
-        meshes,
-        stats: atlas.stats,
-    })
+    Ok(chosen)
 }
 
 #[cfg(test)]

@@ -16,9 +16,11 @@
 
 mod mesh;
 mod parse;
+mod shard;
 mod stream;
 
 pub use mesh::{LabelMeshes, LabelRequest, Selection, extract};
+pub use shard::{LabelSettings, extract_shards, merge_shards};
 pub use stream::extract_stream;
 
 use std::collections::BTreeMap;

@@ -132,7 +132,7 @@ fn stream_atlas<L: Label>(
 
 /// Shares joined as they come, like a binary counter: two joins of as many blocks each merge,
 /// so each share is copied about log₂(blocks) times rather than once per later block.
-struct Joiner<L> {
+pub(super) struct Joiner<L> {
     /// Joined shares, with the blocks each holds, fewer blocks further up.
     stack: Vec<(AtlasBlock<L>, usize)>,
 }
@@ -144,7 +144,7 @@ impl<L> Default for Joiner<L> {
 }
 
 impl<L: Label> Joiner<L> {
-    fn push(&mut self, share: AtlasBlock<L>) -> std::result::Result<(), RuntimeError> {
+    pub(super) fn push(&mut self, share: AtlasBlock<L>) -> std::result::Result<(), RuntimeError> {
         let mut top = (share, 1);
         while let Some((below, blocks)) = self.stack.pop_if(|(_, blocks)| *blocks == top.1) {
             top = (below.merge(top.0)?, blocks + top.1);
@@ -153,7 +153,7 @@ impl<L: Label> Joiner<L> {
         Ok(())
     }
 
-    fn finish(self) -> std::result::Result<AtlasBlock<L>, RuntimeError> {
+    pub(super) fn finish(self) -> std::result::Result<AtlasBlock<L>, RuntimeError> {
         AtlasBlock::merge_all(self.stack.into_iter().map(|(share, _)| share))
     }
 }
