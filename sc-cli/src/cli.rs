@@ -55,11 +55,15 @@ pub enum Command {
     #[command(verbatim_doc_comment)]
     Render(RenderArgs),
     /// Join the shards `extract --shards` (or `skelclimb.dask.extract(..., shards=DIR)`) wrote
-    /// into one mesh: exactly the mesh a single `extract` of the whole volume writes.
+    /// into one mesh: exactly the mesh a single `extract` of the whole volume writes. Shards of
+    /// a label volume (`extract --labels --shards`) join into the files `extract --labels`
+    /// writes: an atlas .glb or a directory of a file per label.
     ///
     /// Examples:
     ///   skelclimb extract scan.nii.gz --iso 300 --shards parts --block 64
     ///   skelclimb merge parts/manifest.json -o bone.ply
+    ///   skelclimb extract seg.nii.gz --labels all --shards seg-parts --block 64
+    ///   skelclimb merge seg-parts/manifest.json -o regions/ --format obj
     #[command(verbatim_doc_comment)]
     Merge(MergeArgs),
 }
@@ -69,9 +73,13 @@ pub enum Command {
 pub struct MergeArgs {
     /// The manifest (`manifest.json` in the shard directory); the shards are beside it.
     pub manifest: PathBuf,
-    /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format.
-    #[arg(short, long, value_parser = parse_output)]
-    pub output: Output,
+    /// The mesh file; its extension (.ply, .obj, .stl, .glb) chooses the format. For label
+    /// shards, a .glb file (a node per label) or a directory (a file per label).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// For label shards merged into a directory: the format of each label's file [default: ply].
+    #[arg(long, value_parser = parse_format)]
+    pub format: Option<MeshFormat>,
     /// Write text PLY instead of binary.
     #[arg(long)]
     pub ascii: bool,
@@ -227,7 +235,7 @@ pub struct ExtractArgs {
     /// chooses which labels get a mesh. With --stream, the same meshes from a few slices at a
     /// time.
     #[arg(long, value_name = "all|LIST", value_parser = sc_io::labels::Selection::parse,
-          conflicts_with_all = ["iso", "demo", "shards", "max_error", "max_box", "allow_wrong_side", "pad"])]
+          conflicts_with_all = ["iso", "demo", "max_error", "max_box", "allow_wrong_side", "pad"])]
     pub labels: Option<sc_io::labels::Selection>,
     /// With --labels: the label of no region, not meshed, and what lies outside the volume.
     #[arg(long, requires = "labels", default_value_t = 0)]
@@ -241,14 +249,17 @@ pub struct ExtractArgs {
     /// within 1 %); every sample stays on its own side. 0 (the default) keeps midpoints.
     #[arg(long, requires = "labels", default_value_t = 0.0, value_parser = parse_smoothing)]
     pub smoothing: f64,
-    /// With --labels and a directory: the format of each label's file.
+    /// With --labels and a directory: the format of each label's file (with --shards, `merge`
+    /// chooses it).
     #[arg(long, requires = "labels", value_parser = parse_format, default_value = "ply")]
     pub format: MeshFormat,
     /// Instead of one mesh file, write one shard per block of cubes into this directory (made
     /// if missing), plus `manifest.json`; `skelclimb merge` joins them into exactly the mesh
     /// `-o` would have written. The volume is read whole and the blocks meshed one after
     /// another: this is for splitting work by hand and for tests; volumes larger than one
-    /// machine are split by the Python package's Dask driver (`shards=`).
+    /// machine are split by the Python package's Dask driver (`shards=`). With --labels, the
+    /// shards hold the atlas's blocks, and the manifest the selection, background, smoothing
+    /// and label table, so that `merge` writes exactly the files `-o` would have.
     #[arg(long, conflicts_with_all = ["output", "stream", "check", "ascii", "stats_json"])]
     pub shards: Option<PathBuf>,
     /// With --shards: cubes per block along each axis [default: 128].
@@ -435,6 +446,11 @@ fn units_help(units: ErrorUnits) -> &'static str {
 }
 
 impl ExtractArgs {
+    /// Cubes per block along each axis with --shards.
+    pub fn block_cubes(&self) -> usize {
+        self.block.unwrap_or(128) as usize
+    }
+
     /// The bound `--max-error` and `--error-units` ask for.
     pub fn error_bound(&self) -> Option<ErrorBound> {
         self.max_error.map(|d| ErrorBound::new(d, self.error_units))
@@ -448,10 +464,6 @@ pub struct Output {
     pub path: PathBuf,
     /// What to write.
     pub format: MeshFormat,
-}
-
-fn parse_output(s: &str) -> Result<Output, String> {
-    Output::new(PathBuf::from(s))
 }
 
 impl Output {
@@ -617,8 +629,11 @@ mod tests {
         assert!(parse_threads("100000").is_err());
         assert_eq!(parse_threads("8"), Ok(8));
         assert!(parse_size("2000").is_err() && parse_size("1").is_err());
-        assert!(parse_output("a.vtk").is_err());
-        assert_eq!(parse_output("A.GLB").map(|o| o.format), Ok(MeshFormat::Glb));
+        assert!(Output::new("a.vtk".into()).is_err());
+        assert_eq!(
+            Output::new("A.GLB".into()).map(|o| o.format),
+            Ok(MeshFormat::Glb)
+        );
         assert_eq!(
             split_iso("a@b.nii@20"),
             (PathBuf::from("a@b.nii"), Some(20.0))

@@ -4,7 +4,7 @@
 //! volume and smoothing; the whole read's refusals hold for the stream and leave no file.
 
 mod common;
-use common::{entries, fixture, gzip, limited};
+use common::{LABEL_DIMS, aal_labels, entries, gzip, label_nifti, limited};
 
 use std::path::Path;
 
@@ -15,44 +15,10 @@ fn skelclimb() -> Command {
     Command::cargo_bin("skelclimb").unwrap()
 }
 
-const DIMS: [usize; 3] = [24, 24, 48];
-
-/// The AAL crop three times along z, the middle copy mirrored: 24 × 24 × 48 u8, x fastest,
-/// so that regions run across the copies' seams and a stream has several blocks.
-fn labels() -> Vec<u8> {
-    let crop = std::fs::read(fixture("labels/aal-crop-24x24x16.u8.raw")).unwrap();
-    let slices: Vec<&[u8]> = crop.chunks_exact(24 * 24).collect();
-    let mut all = Vec::with_capacity(crop.len() * 3);
-    for slice in slices.iter().chain(slices.iter().rev()).chain(&slices) {
-        all.extend_from_slice(slice);
-    }
-    all
-}
-
-/// A NIfTI-1 file of u8 `samples`, unit voxels, no rotation, scaled by `slope` (0: none).
-fn nifti(samples: &[u8], slope: f32) -> Vec<u8> {
-    let mut h = vec![0u8; 352];
-    h[0..4].copy_from_slice(&348i32.to_le_bytes());
-    let dim = [3, DIMS[0], DIMS[1], DIMS[2], 1, 1, 1, 1].map(|d| d as i16);
-    for (i, d) in dim.iter().enumerate() {
-        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
-    }
-    h[70..72].copy_from_slice(&2i16.to_le_bytes()); // DT_UINT8
-    h[72..74].copy_from_slice(&8i16.to_le_bytes());
-    for i in 0..8 {
-        h[76 + 4 * i..80 + 4 * i].copy_from_slice(&1f32.to_le_bytes());
-    }
-    h[108..112].copy_from_slice(&352f32.to_le_bytes());
-    h[112..116].copy_from_slice(&slope.to_le_bytes());
-    h[344..348].copy_from_slice(b"n+1\0");
-    h.extend_from_slice(samples);
-    h
-}
-
 /// A Zarr v2 array of the samples, uncompressed, in chunks of `chunk` whole slices.
 fn zarr(dir: &Path, samples: &[u8], chunk: usize) {
     std::fs::create_dir(dir).unwrap();
-    let [nx, ny, nz] = DIMS;
+    let [nx, ny, nz] = LABEL_DIMS;
     std::fs::write(
         dir.join(".zarray"),
         format!(
@@ -72,15 +38,19 @@ fn zarr(dir: &Path, samples: &[u8], chunk: usize) {
 /// The fixtures in `dir`: `seg.raw` with its sidecar, `seg.nii`, `seg.nii.gz`, and Zarr stores
 /// `z<k>.zarr` in chunks of `k` slices.
 fn fixtures(dir: &Path, chunks: &[usize]) {
-    let samples = labels();
+    let samples = aal_labels();
     std::fs::write(dir.join("seg.raw"), &samples).unwrap();
     std::fs::write(
         dir.join("seg.json"),
         r#"{"dims": [24, 24, 48], "dtype": "u8"}"#,
     )
     .unwrap();
-    std::fs::write(dir.join("seg.nii"), nifti(&samples, 0.0)).unwrap();
-    std::fs::write(dir.join("seg.nii.gz"), gzip(&nifti(&samples, 0.0))).unwrap();
+    std::fs::write(dir.join("seg.nii"), label_nifti(&samples, 0.0, None)).unwrap();
+    std::fs::write(
+        dir.join("seg.nii.gz"),
+        gzip(&label_nifti(&samples, 0.0, None)),
+    )
+    .unwrap();
     for &k in chunks {
         zarr(&dir.join(format!("z{k}.zarr")), &samples, k);
     }
@@ -174,14 +144,14 @@ fn the_stream_refuses_what_the_whole_read_refuses() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     fixtures(d, &[]);
-    let samples = labels();
+    let samples = aal_labels();
     let floats: Vec<u8> = samples
         .iter()
         .flat_map(|&l| f32::from(l).to_le_bytes())
         .collect();
     std::fs::write(d.join("float.raw"), floats).unwrap();
-    std::fs::write(d.join("scaled.nii"), nifti(&samples, 2.0)).unwrap();
-    let gz = gzip(&nifti(&samples, 0.0));
+    std::fs::write(d.join("scaled.nii"), label_nifti(&samples, 2.0, None)).unwrap();
+    let gz = gzip(&label_nifti(&samples, 0.0, None));
     std::fs::write(d.join("cut.nii.gz"), &gz[..gz.len() * 3 / 5]).unwrap();
     let float_args = ["--labels", "all", "--dims", "24,24,48", "--dtype", "f32"];
     let all = ["--labels", "all"];

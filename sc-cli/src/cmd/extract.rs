@@ -369,19 +369,23 @@ fn shards(args: &ExtractArgs, dir: &Path, options: &ReadOptions, quiet: bool) ->
         warn(warning);
     }
     place(args, &mut grid, iso, &input)?;
-    let block = args.block.unwrap_or(128) as usize;
+    let block = args.block_cubes();
     let manifest = surface::extract_shards(&grid, &request(args, iso), block, dir, &progress)?;
     progress.finish();
     if !quiet {
-        let manifest_path = dir.join(sc_io::shard::MANIFEST_NAME);
-        println!(
-            "{input}: {} shards of up to {block}³ cubes in {}; join them with `skelclimb merge {}`",
-            manifest.shards.len(),
-            dir.display(),
-            manifest_path.display()
-        );
+        print_shards(&input, manifest.shards.len(), block, dir);
     }
     Ok(())
+}
+
+/// The summary of `extract --shards`: how many, where, and how to join them.
+pub(super) fn print_shards(input: &str, shards: usize, block: usize, dir: &Path) {
+    let manifest_path = dir.join(sc_io::shard::MANIFEST_NAME);
+    println!(
+        "{input}: {shards} shards of up to {block}³ cubes in {}; join them with `skelclimb merge {}`",
+        dir.display(),
+        manifest_path.display()
+    );
 }
 
 /// About how many bytes `format` writes for `mesh`, for the progress bar: exact for binary PLY

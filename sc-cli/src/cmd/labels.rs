@@ -1,4 +1,5 @@
-//! `skelclimb extract --labels`: every region of a label volume, one closed mesh each.
+//! `skelclimb extract --labels`: every region of a label volume, one closed mesh each, read
+//! whole, streamed or written as shards; and `skelclimb merge` of those shards.
 
 use std::path::Path;
 use std::time::Instant;
@@ -7,7 +8,7 @@ use serde_json::json;
 
 use super::extract::{Volume, check_outputs};
 use super::warn;
-use crate::cli::ExtractArgs;
+use crate::cli::{ExtractArgs, MergeArgs};
 use crate::progress::Bar;
 use crate::summary::{mode_name, thousands};
 use sc_io::atomic::AtomicFile;
@@ -15,6 +16,7 @@ use sc_io::labels::{self, LabelMeshes, LabelRequest, LabelTable};
 use sc_io::read::Format;
 use sc_io::write::{LabelFiles, LabelMesh, MeshFormat, WriteOptions, write_atlas};
 use sc_io::{Error, Result, report};
+use sc_runtime::Mode;
 
 /// Where the meshes go.
 enum Target<'a> {
@@ -24,6 +26,98 @@ enum Target<'a> {
     Files(&'a Path),
 }
 
+impl<'a> Target<'a> {
+    /// Where `-o output` puts the meshes: a .glb atlas, or a directory of `format` files.
+    fn new(output: &'a Path, format: MeshFormat, ascii: bool) -> Result<Target<'a>> {
+        let target = match MeshFormat::from_path(output) {
+            Ok(MeshFormat::Glb) => Target::Atlas(output),
+            Ok(_) => {
+                return Err(Error::Usage(format!(
+                    "-o {}: with --labels, give a .glb file (a node per label) or a directory (a \
+                     file per label, in --format)",
+                    output.display()
+                )));
+            }
+            Err(_) => Target::Files(output),
+        };
+        if ascii && (matches!(target, Target::Atlas(_)) || format != MeshFormat::Ply) {
+            return Err(Error::Usage("--ascii applies to .ply output only".into()));
+        }
+        Ok(target)
+    }
+
+    /// Opens the atlas file (a directory's files are opened when written) and the report file,
+    /// before the long work, so that a bad path fails first.
+    fn create(self, format: MeshFormat, stats: Option<&Path>) -> Result<Outputs<'a>> {
+        let stats = stats.map(AtomicFile::create).transpose()?;
+        let atlas = match self {
+            Target::Atlas(path) => Some(AtomicFile::create(path)?),
+            Target::Files(_) => None,
+        };
+        Ok(Outputs {
+            target: self,
+            format,
+            atlas,
+            stats,
+        })
+    }
+}
+
+/// The files a run writes, opened.
+struct Outputs<'a> {
+    target: Target<'a>,
+    /// The format of a directory's files.
+    format: MeshFormat,
+    atlas: Option<AtomicFile>,
+    stats: Option<AtomicFile>,
+}
+
+impl Outputs<'_> {
+    /// Writes the meshes of `result`, named and coloured by `table`, and the report `report`
+    /// gives for the time the writing took: all files or none.
+    fn write(
+        self,
+        result: &LabelMeshes,
+        table: Option<&LabelTable>,
+        options: &WriteOptions,
+        report: impl FnOnce(std::time::Duration) -> serde_json::Value,
+    ) -> Result<()> {
+        let clock = Instant::now();
+        let meshes: Vec<LabelMesh> = result
+            .meshes
+            .iter()
+            .map(|(id, mesh)| LabelMesh {
+                id: *id,
+                label: table.and_then(|t| t.get(*id)),
+                mesh: mesh.into(),
+            })
+            .collect();
+        match (self.target, self.atlas) {
+            (Target::Atlas(_), Some(file)) => {
+                let filled = file.fill(|out| write_atlas(&meshes, options, out))?;
+                let written = clock.elapsed();
+                super::commit_with_report(filled, self.stats, || report(written))
+            }
+            (Target::Files(dir), _) => {
+                let files = LabelFiles::fill(dir, &meshes, self.format, options)?;
+                let written = clock.elapsed();
+                let report_file = match self.stats {
+                    Some(file) => Some(file.fill(|out| {
+                        serde_json::to_writer_pretty(out, &report(written))
+                            .map_err(std::io::Error::other)
+                    })?),
+                    None => None,
+                };
+                crate::interrupt::finish(|| {
+                    files.commit()?;
+                    report_file.map_or(Ok(()), |filled| filled.commit())
+                })
+            }
+            (Target::Atlas(_), None) => unreachable!("the atlas file is created with its target"),
+        }
+    }
+}
+
 /// Reads the label volume, meshes the labels asked for and writes them: all files or none.
 pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let options = args.read.read_options();
@@ -31,27 +125,67 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         return Err(Error::Usage("--labels needs an input volume".into()));
     };
     let format = Format::detect(input, &options)?;
+    if let Some(dir) = &args.shards {
+        return shards(args, input, dir, quiet);
+    }
     let Some(output) = &args.output else {
         return Err(Error::Usage(
             "give -o ATLAS.glb (a node per label) or -o DIR (a file per label)".into(),
         ));
     };
-    let target = match MeshFormat::from_path(output) {
-        Ok(MeshFormat::Glb) => Target::Atlas(output),
-        Ok(_) => {
-            return Err(Error::Usage(format!(
-                "-o {}: with --labels, give a .glb file (a node per label) or a directory (a \
-                 file per label, in --format)",
-                output.display()
-            )));
-        }
-        Err(_) => Target::Files(output),
-    };
-    if args.ascii && (matches!(target, Target::Atlas(_)) || args.format != MeshFormat::Ply) {
-        return Err(Error::Usage("--ascii applies to .ply output only".into()));
-    }
+    let target = Target::new(output, args.format, args.ascii)?;
     check_outputs(Some(input), output, args.stats_json.as_deref())?;
-    let table = match &args.label_table {
+    let table = table(args, input)?;
+    let outputs = target.create(args.format, args.stats_json.as_deref())?;
+    let progress = Bar::new(!quiet);
+
+    let clock = Instant::now();
+    let (mut volume, _, _) = super::extract::open(args, Some(format), &options, &progress)?;
+    let read_time = clock.elapsed();
+    args.placement.apply(volume.grid_mut());
+    let clock = Instant::now();
+    let request = request(args);
+    let result = match &mut volume {
+        Volume::Whole(grid) => labels::extract(grid, &request, &progress),
+        Volume::Streamed(stream) => labels::extract_stream(stream, &request, &progress),
+    }
+    .map_err(|e| at_file(e, input))?;
+    let extract_time = clock.elapsed();
+    let grid = volume.grid();
+    for warning in &grid.warnings {
+        warn(warning);
+    }
+
+    let world = sc_io::space::World::new(grid.frame, grid.origin, args.space);
+    let write_options = WriteOptions {
+        ascii: args.ascii,
+        space: world.space,
+    };
+    let summary = summary(args, input, grid, &result, [read_time, extract_time]);
+    outputs.write(&result, table.as_ref(), &write_options, |written| {
+        let mut json = summary.clone();
+        json["seconds"]["write"] = json!(written.as_secs_f64());
+        json
+    })?;
+    progress.finish();
+    if !quiet {
+        print(&summary, output);
+    }
+    Ok(())
+}
+
+/// A usage error found in the volume (a label no sample holds) as an error naming `file`.
+fn at_file(e: Error, file: &Path) -> Error {
+    match e {
+        Error::Usage(message) => Error::file(file, message),
+        e => e,
+    }
+}
+
+/// The label table: `--label-table`, or those beside the volume (a table there that cannot be
+/// read is a warning, not an error).
+fn table(args: &ExtractArgs, input: &Path) -> Result<Option<LabelTable>> {
+    Ok(match &args.label_table {
         Some(path) => Some(LabelTable::read(path)?),
         None => {
             let beside = LabelTable::beside(input);
@@ -60,24 +194,12 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
             }
             beside.table
         }
-    };
-    let stats_file = args
-        .stats_json
-        .as_deref()
-        .map(AtomicFile::create)
-        .transpose()?;
-    let atlas_file = match target {
-        Target::Atlas(path) => Some(AtomicFile::create(path)?),
-        Target::Files(_) => None,
-    };
-    let progress = Bar::new(!quiet);
+    })
+}
 
-    let clock = Instant::now();
-    let (mut volume, _, _) = super::extract::open(args, Some(format), &options, &progress)?;
-    let read_time = clock.elapsed();
-    args.placement.apply(volume.grid_mut());
-    let clock = Instant::now();
-    let request = LabelRequest {
+/// What the arguments ask of the label sweep.
+fn request(args: &ExtractArgs) -> LabelRequest {
+    LabelRequest {
         background: args.background,
         mode: args.mode,
         normals: !args.no_normals,
@@ -85,70 +207,105 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         coordinates: args.space,
         selection: args.labels.clone().unwrap_or(labels::Selection::All),
         smoothing: args.smoothing,
-    };
-    let result = match &mut volume {
-        Volume::Whole(grid) => labels::extract(grid, &request, &progress),
-        Volume::Streamed(stream) => labels::extract_stream(stream, &request, &progress),
     }
-    .map_err(|e| match e {
-        Error::Usage(message) => Error::file(input, message),
-        e => e,
-    })?;
-    let extract_time = clock.elapsed();
-    let grid = volume.grid();
+}
+
+/// `extract --labels --shards`: the volume read whole, a shard per block of its atlas and a
+/// manifest that records the table and the selection for `merge`.
+fn shards(args: &ExtractArgs, input: &Path, dir: &Path, quiet: bool) -> Result<()> {
+    let table = table(args, input)?;
+    let progress = Bar::new(!quiet);
+    let (mut grid, _, _) = super::extract::load(args, &args.read.read_options(), &progress)?;
     for warning in &grid.warnings {
         warn(warning);
     }
-
-    let clock = Instant::now();
-    let world = sc_io::space::World::new(grid.frame, grid.origin, args.space);
-    let write_options = WriteOptions {
-        ascii: args.ascii,
-        space: world.space,
-    };
-    let meshes: Vec<LabelMesh> = result
-        .meshes
-        .iter()
-        .map(|(id, mesh)| LabelMesh {
-            id: *id,
-            label: table.as_ref().and_then(|t| t.get(*id)),
-            mesh: mesh.into(),
-        })
-        .collect();
-    let summary = summary(args, input, grid, &result, [read_time, extract_time]);
-    let report = |written: std::time::Duration| {
-        let mut json = summary.clone();
-        json["seconds"]["write"] = json!(written.as_secs_f64());
-        json
-    };
-    match (target, atlas_file) {
-        (Target::Atlas(_), Some(file)) => {
-            let filled = file.fill(|out| write_atlas(&meshes, &write_options, out))?;
-            let written = clock.elapsed();
-            super::commit_with_report(filled, stats_file, || report(written))?;
-        }
-        (Target::Files(dir), _) => {
-            let files = LabelFiles::fill(dir, &meshes, args.format, &write_options)?;
-            let written = clock.elapsed();
-            let report_file = match stats_file {
-                Some(file) => Some(file.fill(|out| {
-                    serde_json::to_writer_pretty(out, &report(written))
-                        .map_err(std::io::Error::other)
-                })?),
-                None => None,
-            };
-            crate::interrupt::finish(|| {
-                files.commit()?;
-                report_file.map_or(Ok(()), |filled| filled.commit())
-            })?;
-        }
-        (Target::Atlas(_), None) => unreachable!("the atlas file is created with its target"),
-    }
+    args.placement.apply(&mut grid);
+    let block = args.block_cubes();
+    let manifest =
+        labels::extract_shards(&grid, &request(args), table.as_ref(), block, dir, &progress)
+            .map_err(|e| at_file(e, input))?;
     progress.finish();
     if !quiet {
-        print(&summary, output);
+        super::extract::print_shards(
+            &input.display().to_string(),
+            manifest.shards.len(),
+            block,
+            dir,
+        );
     }
     Ok(())
+}
+
+/// `merge` of label shards: the files `extract --labels -o` writes, all or none.
+pub fn merge(args: &MergeArgs, quiet: bool) -> Result<()> {
+    let format = args.format.unwrap_or(MeshFormat::Ply);
+    let target = Target::new(&args.output, format, args.ascii)?;
+    check_outputs(
+        Some(&args.manifest),
+        &args.output,
+        args.stats_json.as_deref(),
+    )?;
+    let outputs = target.create(format, args.stats_json.as_deref())?;
+    let clock = Instant::now();
+    let (manifest, result) = labels::merge_shards(&args.manifest)?;
+    let merge_time = clock.elapsed();
+    let settings = &manifest.settings;
+    let write_options = WriteOptions {
+        ascii: args.ascii,
+        space: manifest.world.space,
+    };
+    let mut summary = json!({
+        "manifest": args.manifest.display().to_string(),
+        "shards": manifest.shards.len(),
+        "dims": manifest.grid,
+        "dtype": settings.dtype.name(),
+        "background": settings.background,
+        "smoothing": settings.smoothing,
+    });
+    add_counts(&mut summary, settings.mode, &result);
+    summary["seconds"] = json!({ "merge": merge_time.as_secs_f64() });
+    outputs.write(
+        &result,
+        settings.table.as_ref(),
+        &write_options,
+        |written| {
+            summary["seconds"]["write"] = json!(written.as_secs_f64());
+            summary.clone()
+        },
+    )?;
+    if !quiet {
+        println!(
+            "{}: {} shards of a {} × {} × {} grid, {}: {} labels, atlas {} triangles; per-label \
+             meshes {} triangles → {}",
+            args.manifest.display(),
+            manifest.shards.len(),
+            manifest.grid[0],
+            manifest.grid[1],
+            manifest.grid[2],
+            mode_name(settings.mode),
+            result.meshes.len(),
+            thousands(result.stats.triangles),
+            thousands(per_label_triangles(&result)),
+            args.output.display(),
+        );
+    }
+    Ok(())
+}
+
+/// Triangles of the meshes per label, together: each interface twice.
+fn per_label_triangles(result: &LabelMeshes) -> u64 {
+    result
+        .meshes
+        .iter()
+        .map(|(_, m)| m.triangles.len() as u64)
+        .sum()
+}
+
+/// Adds the labels meshed and the counts to a report.
+fn add_counts(json: &mut serde_json::Value, mode: Mode, result: &LabelMeshes) {
+    json["labels"] = json!(result.meshes.iter().map(|(id, _)| *id).collect::<Vec<_>>());
+    json["atlas"] = serde_json::Value::Object(report::counts(mode, None, &result.stats));
+    json["per_label_triangles"] = json!(per_label_triangles(result));
 }
 
 /// The run's report, as `--stats-json` writes it.
@@ -159,23 +316,17 @@ fn summary(
     result: &LabelMeshes,
     [read, extract]: [std::time::Duration; 2],
 ) -> serde_json::Value {
-    let per_label: u64 = result
-        .meshes
-        .iter()
-        .map(|(_, m)| m.triangles.len() as u64)
-        .sum();
-    json!({
+    let mut json = json!({
         "input": input.display().to_string(),
         "format": grid.format,
         "dims": grid.dims,
         "dtype": grid.samples.dtype().name(),
         "background": args.background,
         "smoothing": args.smoothing,
-        "labels": result.meshes.iter().map(|(id, _)| *id).collect::<Vec<_>>(),
-        "atlas": report::counts(args.mode, None, &result.stats),
-        "per_label_triangles": per_label,
-        "seconds": { "read": read.as_secs_f64(), "extract": extract.as_secs_f64() },
-    })
+    });
+    add_counts(&mut json, args.mode, result);
+    json["seconds"] = json!({ "read": read.as_secs_f64(), "extract": extract.as_secs_f64() });
+    json
 }
 
 /// The report in words.

@@ -1,22 +1,36 @@
-//! `skelclimb merge`: shards in, one mesh out.
+//! `skelclimb merge`: shards in, one mesh out (or, for a label volume's shards, its meshes).
 
 use std::time::Instant;
 
 use serde_json::json;
 
-use crate::cli::MergeArgs;
+use crate::cli::{MergeArgs, Output};
 use crate::summary::{self, mode_name, thousands};
 use sc_io::atomic::AtomicFile;
-use sc_io::shard;
+use sc_io::labels::LabelSettings;
+use sc_io::shard::{self, ShardSettings};
 use sc_io::write::{MeshFormat, WriteOptions};
 use sc_io::{Error, Result};
 
 /// Joins the shards the manifest lists and writes the mesh (and the counts), whole or not at all.
+/// The manifest's kind is read first, to know what `-o` must name.
 pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {
-    if args.ascii && args.output.format != MeshFormat::Ply {
+    if shard::kind(&args.manifest)? == LabelSettings::KIND {
+        return super::labels::merge(args, quiet);
+    }
+    let output = Output::new(args.output.clone())
+        .map_err(|e| Error::Usage(format!("-o {}: {e}", args.output.display())))?;
+    if args.format.is_some() {
+        return Err(Error::Usage(
+            "--format applies to label shards merged into a directory; -o's extension chooses \
+             the mesh format"
+                .into(),
+        ));
+    }
+    if args.ascii && output.format != MeshFormat::Ply {
         return Err(Error::Usage("--ascii applies to .ply output only".into()));
     }
-    let mesh_file = AtomicFile::create(&args.output.path)?;
+    let mesh_file = AtomicFile::create(&output.path)?;
     let stats_file = args
         .stats_json
         .as_deref()
@@ -30,7 +44,7 @@ pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {
         ascii: args.ascii,
         space: manifest.world.space,
     };
-    let mesh_filled = mesh_file.fill(|out| args.output.format.write(&mesh, &options, out))?;
+    let mesh_filled = mesh_file.fill(|out| output.format.write(&mesh, &options, out))?;
     let write_time = clock.elapsed();
     let settings = &manifest.settings;
     super::commit_with_report(mesh_filled, stats_file, || {
