@@ -300,5 +300,11 @@ mod tests {
             assert!(Selection::parse(bad).is_err(), "{bad:?}");
         }
         assert!(Selection::parse("5-2").unwrap_err().contains("backwards"));
+        // Written as it is read, for shard manifests.
+        for text in ["all", "7", "1,5,17-20", "0-0,3-4"] {
+            let selection = Selection::parse(text).unwrap();
+            assert_eq!(Selection::parse(&selection.to_string()), Ok(selection));
+        }
+        assert_eq!(Selection::parse("3, 4-6").unwrap().to_string(), "3,4-6");
     }
 }

@@ -269,37 +269,49 @@ impl Job<'_> {
         present.remove(&params.background);
         let present: Vec<L> = present.into_iter().collect();
         mesh::chosen(&present, self.request)?;
-        let mut manifest = Manifest {
+        let manifest = Manifest {
             grid: dims,
             settings: LabelSettings::new(dtype, &params, self.request, self.table),
             world: self.world,
             shards: Vec::new(),
         };
-        std::fs::create_dir_all(self.dir).map_err(|e| Error::io(self.dir, e))?;
-        let cubes = manifest.settings.key_grid(dims).map(|n| n - 1);
-        self.progress.phase(
-            "meshing labels",
-            shard::blocks(cubes, self.block).count() as u64,
-        );
-        for cubes in shard::blocks(cubes, self.block) {
-            let need = sc_runtime::labels::block_samples(dims, cubes.clone(), &params)?;
-            let samples = cut(data, dims, &need);
-            let at = need.clone().map(|r| r.start);
-            let volume = Volume::new(&samples, need.map(|r| r.len()))?;
-            let share = extract_block(volume, at, dims, cubes.clone(), &params)?;
-            let entry = ShardEntry {
-                file: ShardEntry::file_name(&cubes),
-                cubes,
-                vertices: share.keys.len() as u64,
-                triangles: share.triangles.len() as u64,
-            };
-            write_shard(&self.dir.join(&entry.file), &share, &manifest.settings)?;
-            manifest.shards.push(entry);
-            self.progress.inc(1);
-        }
-        manifest.write(&self.dir.join(MANIFEST_NAME))?;
-        Ok(manifest)
+        write_blocks(data, &params, manifest, self.block, self.dir, self.progress)
     }
+}
+
+/// Meshes the volume `data` of `manifest.grid` samples swept with `params` in blocks of up to
+/// `block` cubes per axis, writes their shards into `dir`, lists them in `manifest` and writes
+/// it.
+fn write_blocks<L: Stored>(
+    data: &[L],
+    params: &LabelParams<L>,
+    mut manifest: Manifest<LabelSettings>,
+    block: usize,
+    dir: &Path,
+    progress: &dyn Progress,
+) -> Result<Manifest<LabelSettings>> {
+    let dims = manifest.grid;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let cubes = manifest.settings.key_grid(dims).map(|n| n - 1);
+    progress.phase("meshing labels", shard::blocks(cubes, block).count() as u64);
+    for cubes in shard::blocks(cubes, block) {
+        let need = sc_runtime::labels::block_samples(dims, cubes.clone(), params)?;
+        let samples = cut(data, dims, &need);
+        let at = need.clone().map(|r| r.start);
+        let volume = Volume::new(&samples, need.map(|r| r.len()))?;
+        let share = extract_block(volume, at, dims, cubes.clone(), params)?;
+        let entry = ShardEntry {
+            file: ShardEntry::file_name(&cubes),
+            cubes,
+            vertices: share.keys.len() as u64,
+            triangles: share.triangles.len() as u64,
+        };
+        write_shard(&dir.join(&entry.file), &share, &manifest.settings)?;
+        manifest.shards.push(entry);
+        progress.inc(1);
+    }
+    manifest.write(&dir.join(MANIFEST_NAME))?;
+    Ok(manifest)
 }
 
 /// Writes `share`, swept with `settings`, to the shard file `path`, whole or not at all.
@@ -417,4 +429,77 @@ fn merge_typed<L: Stored>(path: &Path, manifest: &Manifest<LabelSettings>) -> Re
         Error::Usage(message) => Error::file(path, message),
         e => e,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::labels::stream::tests::volume;
+    use crate::progress::Silent;
+    use crate::space::Coordinates;
+    use sc_runtime::labels::extract_labels;
+
+    /// Shards of every block size join into the meshes and counts of the whole volume, padded
+    /// or not (the command line always pads), smoothed or not, with a background inside the
+    /// volume; the manifest, table and selection included, reads back as written.
+    #[test]
+    fn shards_padded_or_not_merge_into_the_whole_meshes() {
+        let dims = [9, 7, 23];
+        let labels = volume(dims, 5);
+        let table: LabelTable = [(3, "three", Some([1, 2, 3])), (5, "", None)]
+            .into_iter()
+            .map(|(id, name, rgb)| {
+                let label = Label {
+                    name: name.into(),
+                    rgb,
+                };
+                (id, label)
+            })
+            .collect();
+        for (pad, smoothing, background, selection) in [
+            (true, 0.0, 0, Selection::All),
+            (false, 0.0, 0, Selection::parse("1-3,5").unwrap()),
+            (false, 1.5, 2, Selection::All),
+            (true, 0.75, 3, Selection::parse("0,4-6").unwrap()),
+        ] {
+            let params = LabelParams {
+                pad,
+                smoothing,
+                background,
+                spacing: [0.5, 1.0, 2.0],
+                origin: [1.0, -2.0, 3.0],
+                threads: 1,
+                ..LabelParams::default()
+            };
+            let request = LabelRequest {
+                background: u64::from(background),
+                mode: params.mode,
+                normals: true,
+                threads: 1,
+                coordinates: Coordinates::Index,
+                selection,
+                smoothing,
+            };
+            let whole = extract_labels(Volume::new(&labels, dims).unwrap(), &params).unwrap();
+            let whole = mesh::select(whole, background, &request).unwrap();
+            assert!(whole.meshes.len() >= 3 && whole.stats.merged > 0);
+            for block in [3, 8, 40] {
+                let dir = tempfile::tempdir().unwrap();
+                let manifest = Manifest {
+                    grid: dims,
+                    settings: LabelSettings::new(Dtype::U16, &params, &request, Some(&table)),
+                    world: World::new(None, params.origin, Coordinates::Index),
+                    shards: Vec::new(),
+                };
+                let written =
+                    write_blocks(&labels, &params, manifest, block, dir.path(), &Silent).unwrap();
+                let (read, merged) = merge_shards(&dir.path().join(MANIFEST_NAME)).unwrap();
+                assert_eq!(read, written);
+                assert!(
+                    merged.meshes == whole.meshes && merged.stats == whole.stats,
+                    "pad {pad}, smoothing {smoothing}, background {background}, blocks of {block}"
+                );
+            }
+        }
+    }
 }

@@ -159,7 +159,7 @@ impl<L: Label> Joiner<L> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::progress::Silent;
     use sc_runtime::Mode;
@@ -167,7 +167,7 @@ mod tests {
 
     /// Labels of a volume with regions of every shape: cells around a few seeds, cut by noise
     /// in a band, so that the volume has junctions of three and more labels and merges.
-    fn volume(dims: [usize; 3], seed: u64) -> Vec<u16> {
+    pub(in crate::labels) fn volume(dims: [usize; 3], seed: u64) -> Vec<u16> {
         let [nx, ny, nz] = dims;
         let mut state = seed;
         let mut random = || {
