@@ -6,7 +6,7 @@
 //! with exit status 1 and no file left behind.
 
 mod common;
-use common::{LABEL_DIMS, aal_labels, entries, label_nifti};
+use common::{LABEL_DIMS, aal_labels, entries, label_nifti, written};
 
 use std::path::Path;
 
@@ -47,22 +47,6 @@ fn fixtures(dir: &Path) {
          73 10 10 250 1 1 1 \"Putamen L\"\n",
     )
     .unwrap();
-}
-
-/// The files under `out` in `dir` (every file of a directory, by name; a single file unnamed).
-fn files(dir: &Path, out: &str) -> Vec<(String, Vec<u8>)> {
-    let path = dir.join(out);
-    if path.is_dir() {
-        entries(&path)
-            .into_iter()
-            .map(|name| {
-                let bytes = std::fs::read(path.join(&name)).unwrap();
-                (name, bytes)
-            })
-            .collect()
-    } else {
-        vec![(String::new(), std::fs::read(&path).unwrap())]
-    }
 }
 
 /// The atlas's counts and the labels meshed, from a `--stats-json` report.
@@ -150,7 +134,7 @@ fn label_shards_merge_into_the_whole_extracts_files() {
             .args(ascii.then_some("--ascii"))
             .assert()
             .success();
-        let want = files(d, &whole);
+        let want = written(&d.join(&whole));
         assert!(want.len() >= 2 || out.ends_with(".glb"), "{out}");
         assert!(want.iter().all(|(_, b)| b.len() > 1000), "{out}");
         for block in ["7", "16", "64"] {
@@ -167,7 +151,7 @@ fn label_shards_merge_into_the_whole_extracts_files() {
                 .args(merge_args)
                 .assert()
                 .success();
-            let got = files(d, &joined);
+            let got = written(&d.join(&joined));
             let names =
                 |f: &[(String, Vec<u8>)]| f.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
             assert_eq!(names(&got), names(&want), "{out} block {block}");

@@ -4,7 +4,7 @@
 //! volume and smoothing; the whole read's refusals hold for the stream and leave no file.
 
 mod common;
-use common::{LABEL_DIMS, aal_labels, entries, gzip, label_nifti, limited};
+use common::{LABEL_DIMS, aal_labels, entries, gzip, label_nifti, limited, written};
 
 use std::path::Path;
 
@@ -70,18 +70,7 @@ fn extract(dir: &Path, input: &str, out: &str, args: &[&str]) -> Written {
         .args(args)
         .assert()
         .success();
-    let path = dir.join(out);
-    let files = if path.is_dir() {
-        entries(&path)
-            .into_iter()
-            .map(|name| {
-                let bytes = std::fs::read(path.join(&name)).unwrap();
-                (name, bytes)
-            })
-            .collect()
-    } else {
-        vec![(String::new(), std::fs::read(&path).unwrap())]
-    };
+    let files = written(&dir.join(out));
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join(stats)).unwrap()).unwrap();
     let counts = format!(

@@ -275,14 +275,8 @@ pub fn merge(args: &MergeArgs, quiet: bool) -> Result<()> {
     )?;
     if !quiet {
         println!(
-            "{}: {} shards of a {} × {} × {} grid, {}: {} labels, atlas {} triangles; per-label \
-             meshes {} triangles → {}",
-            args.manifest.display(),
-            manifest.shards.len(),
-            manifest.grid[0],
-            manifest.grid[1],
-            manifest.grid[2],
-            mode_name(settings.mode),
+            "{}: {} labels, atlas {} triangles; per-label meshes {} triangles → {}",
+            super::merge::described(args, manifest.shards.len(), manifest.grid, settings.mode),
             result.meshes.len(),
             thousands(result.stats.triangles),
             thousands(per_label_triangles(&result)),

@@ -4,6 +4,8 @@ use std::time::Instant;
 
 use serde_json::json;
 
+use sc_runtime::Mode;
+
 use crate::cli::{MergeArgs, Output};
 use crate::summary::{self, mode_name, thousands};
 use sc_io::atomic::AtomicFile;
@@ -60,13 +62,8 @@ pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {
     })?;
     if !quiet {
         println!(
-            "{}: {} shards of a {} × {} × {} grid, {}: {} vertices, {} triangles\n  time: merge {:.3} s, write {:.3} s",
-            args.manifest.display(),
-            manifest.shards.len(),
-            manifest.grid[0],
-            manifest.grid[1],
-            manifest.grid[2],
-            mode_name(settings.mode),
+            "{}: {} vertices, {} triangles\n  time: merge {:.3} s, write {:.3} s",
+            described(args, manifest.shards.len(), manifest.grid, settings.mode),
             thousands(mesh.stats.vertices),
             thousands(mesh.stats.triangles),
             merge_time.as_secs_f64(),
@@ -74,4 +71,16 @@ pub fn run(args: &MergeArgs, quiet: bool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The start of `merge`'s report in words: the manifest, its shards, grid and mode.
+pub(super) fn described(args: &MergeArgs, shards: usize, grid: [usize; 3], mode: Mode) -> String {
+    format!(
+        "{}: {shards} shards of a {} × {} × {} grid, {}",
+        args.manifest.display(),
+        grid[0],
+        grid[1],
+        grid[2],
+        mode_name(mode)
+    )
 }

@@ -22,6 +22,21 @@ pub fn entries(dir: &Path) -> Vec<String> {
     v
 }
 
+/// The files at `path`: every file of a directory, by name, or a single file, unnamed.
+pub fn written(path: &Path) -> Vec<(String, Vec<u8>)> {
+    if path.is_dir() {
+        entries(path)
+            .into_iter()
+            .map(|name| {
+                let bytes = std::fs::read(path.join(&name)).unwrap();
+                (name, bytes)
+            })
+            .collect()
+    } else {
+        vec![(String::new(), std::fs::read(path).unwrap())]
+    }
+}
+
 /// The itk-t1 fixture as an uncompressed `.nii`, for tests that patch its header.
 pub fn nifti() -> Vec<u8> {
     let gz = std::fs::read(fixture("itk-t1-mri.nii.gz")).unwrap();
