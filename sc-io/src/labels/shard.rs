@@ -434,7 +434,7 @@ fn merge_typed<L: Stored>(path: &Path, manifest: &Manifest<LabelSettings>) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::labels::stream::tests::volume;
+    use crate::labels::stream::tests::{params, volume};
     use crate::progress::Silent;
     use crate::space::Coordinates;
     use sc_runtime::labels::extract_labels;
@@ -462,15 +462,7 @@ mod tests {
             (false, 1.5, 2, Selection::All),
             (true, 0.75, 3, Selection::parse("0,4-6").unwrap()),
         ] {
-            let params = LabelParams {
-                pad,
-                smoothing,
-                background,
-                spacing: [0.5, 1.0, 2.0],
-                origin: [1.0, -2.0, 3.0],
-                threads: 1,
-                ..LabelParams::default()
-            };
+            let params = params(pad, Mode::Embedded, smoothing, background);
             let request = LabelRequest {
                 background: u64::from(background),
                 mode: params.mode,

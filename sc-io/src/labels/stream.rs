@@ -199,6 +199,25 @@ pub(super) mod tests {
         labels
     }
 
+    /// Parameters with anisotropic spacing and an origin, on one thread.
+    pub(in crate::labels) fn params(
+        pad: bool,
+        mode: Mode,
+        smoothing: f64,
+        background: u16,
+    ) -> LabelParams<u16> {
+        LabelParams {
+            pad,
+            mode,
+            smoothing,
+            background,
+            spacing: [0.5, 1.0, 2.0],
+            origin: [1.0, -2.0, 3.0],
+            threads: 1,
+            ..LabelParams::default()
+        }
+    }
+
     /// Streams `labels` in slabs of `slab` slices with blocks of `block_layers`.
     fn streamed(
         labels: &[u16],
@@ -228,16 +247,7 @@ pub(super) mod tests {
             (true, Mode::Embedded, 0.75, 0),
             (false, Mode::Embedded, 2.0, 2),
         ] {
-            let params = LabelParams {
-                pad,
-                mode,
-                smoothing,
-                background,
-                spacing: [0.5, 1.0, 2.0],
-                origin: [1.0, -2.0, 3.0],
-                threads: 1,
-                ..LabelParams::default()
-            };
+            let params = params(pad, mode, smoothing, background);
             let volume = Volume::new(&labels, dims).unwrap();
             let whole = extract_labels(volume, &params).unwrap();
             assert!(whole.stats.triangles > 500);
