@@ -187,8 +187,8 @@ fn refused(dir: &Path, manifest: &str, out: &str, extra: &[&str], code: i32, mes
 }
 
 /// A missing shard, a scan's shard where a label shard is listed (and the reverse), a shard made
-/// with other options, and outputs that do not fit the shards are refused, naming the file or
-/// the argument, and leave no file.
+/// with other options, a damaged shard, and outputs that do not fit the shards are refused,
+/// naming the file or the argument, and leave no file.
 #[test]
 fn merge_refuses_missing_foreign_and_mismatched_shards() {
     let dir = tempfile::tempdir().unwrap();
@@ -250,6 +250,16 @@ fn merge_refuses_missing_foreign_and_mismatched_shards() {
         refused(d, "a/manifest.json", out, &[], 1, &format!("a/{first}"));
         std::fs::copy(d.join("b").join(first), d.join("a").join(first)).unwrap();
     }
+    // A flipped bit in a label shard: the zip's CRC-32 catches it.
+    let path = d.join("b").join(first);
+    let good = std::fs::read(&path).unwrap();
+    let mut bad = good.clone();
+    let middle = bad.len() / 2;
+    bad[middle] ^= 0x40;
+    std::fs::write(&path, &bad).unwrap();
+    let message = format!("b/{first}: not a readable shard");
+    refused(d, "b/manifest.json", "atlas.glb", &[], 1, &message);
+    std::fs::write(&path, &good).unwrap();
     // A label shard where a scan's manifest lists one.
     std::fs::copy(d.join("b").join(first), d.join("scan").join(first)).unwrap();
     refused(

@@ -174,8 +174,10 @@ impl ShardSettings for LabelSettings {
         }
     }
 
+    /// Saturating: a manifest's grid may be any number, and one this large is refused by the
+    /// cover check, not wrapped.
     fn key_grid(&self, grid: [usize; 3]) -> [usize; 3] {
-        grid.map(|n| n + 2 * usize::from(self.pad))
+        grid.map(|n| n.saturating_add(2 * usize::from(self.pad)))
     }
 }
 
