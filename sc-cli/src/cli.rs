@@ -432,7 +432,7 @@ fn mode_help(mode: Mode) -> &'static str {
         Mode::Paper => "Steps 1–4, merging every interior grey edge, as the paper does",
         Mode::Steps123 => "Steps 1–3 only: no merging",
         Mode::Adaptive => {
-            "Steps 1–3 with boxes of up to 16³ cubes meshed as one within --max-error (0.5 voxel by default), every sample kept on its side; one thread, or blocks with --shards (not --stream)"
+            "Steps 1–3 with boxes of up to 16³ cubes meshed as one within --max-error (0.5 voxel by default), every sample kept on its side; on threads, in blocks with --shards, or streamed"
         }
     }
 }

@@ -50,6 +50,7 @@ pub mod progress;
 pub mod read;
 pub mod report;
 pub mod shard;
+mod slabs;
 pub mod space;
 #[cfg(feature = "surface")]
 pub mod surface;

@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::progress::{Progress, Silent};
 use crate::read::stream::Stream;
 use crate::shard::{MANIFEST_NAME, Manifest, ShardEntry, blocks, write_shard};
+use crate::slabs::stream_blocks;
 use crate::space::{Coordinates, World};
 use crate::volume::{Grid, Range, Sample, cut};
 use crate::{with_dtype, with_samples};
@@ -132,7 +133,8 @@ pub fn extract_measured(
 }
 
 /// Extracts the surface of a volume read slab by slab: the same mesh as [`extract`] of the
-/// whole volume, holding a few slices instead of all of them, on one thread.
+/// whole volume, holding a few slices instead of all of them (in adaptive mode, a block of
+/// slices with its halo: up to some 250 slices with boxes of 16), on one thread.
 pub fn extract_stream(
     stream: &mut Stream,
     request: &Request,
@@ -205,6 +207,9 @@ fn stream_typed<T: Sample>(
     params: &Params,
     progress: &dyn Progress,
 ) -> Result<Mesh> {
+    if params.mode == Mode::Adaptive {
+        return stream_boxes::<T>(stream, params, progress);
+    }
     let dims = stream.grid.dims;
     let nxy = dims[0] * dims[1];
     let len = Scratch::len(dims)?;
@@ -226,6 +231,31 @@ fn stream_typed<T: Sample>(
     let (mut mesh, stats) = streamer.finish()?;
     mesh.stats = stats;
     Ok(mesh)
+}
+
+/// Adaptive mode's surface of a volume read slab by slab, in blocks of whole cube layers
+/// ([`crate::slabs`]): a cube layer's boxes and their balancing read up to `2 × max_box + 2`
+/// cubes before it and `3 × max_box + 2` past it, rounded out to whole boxes (115 slices with
+/// boxes of 16), far more than the slice streamer holds. Each block is at least as thick as
+/// that halo, so that it sweeps at most about twice the cubes it owns.
+fn stream_boxes<T: Sample>(
+    stream: &mut Stream,
+    params: &Params,
+    progress: &dyn Progress,
+) -> Result<Mesh> {
+    let dims = stream.grid.dims;
+    let cubes = dims.map(|n| n.saturating_sub(1));
+    let halo = if cubes.contains(&0) {
+        0
+    } else {
+        let middle = cubes[2] / 2;
+        let layer = [0..cubes[0], 0..cubes[1], middle..middle + 1];
+        block_samples(dims, layer, params)?[2].len()
+    };
+    let slab = stream.slab();
+    let next = || stream.read::<T>(slab);
+    let share = stream_blocks(params, dims, halo.max(16), next, progress)?;
+    Ok(share.into_mesh()?)
 }
 
 fn run<T: Sample>(

@@ -33,6 +33,11 @@ def test_boxes_save_triangles_and_max_box_one_is_steps123():
     default = skelclimb.extract(v, 0.0, mode="adaptive")
     assert len(default.faces) == counts[-1]
     assert _closed(default)
+    # Its boxes shared out over threads: the same mesh.
+    for threads in (1, 3):
+        again = skelclimb.extract(v, 0.0, mode="adaptive", threads=threads)
+        assert np.array_equal(again.faces, default.faces)
+        assert np.array_equal(again.vertices, default.vertices)
 
 
 def test_allowing_wrong_side_never_adds_triangles():

@@ -258,6 +258,13 @@ fn holds_allowing<T: Sample>(
     };
     let mesh = run(vol, &params);
     let what = format!("{what} at {bound} voxel, allow_wrong_side {allow_wrong_side}");
+    // Its boxes shared out over threads, in ranges of some 64 boxes: the same mesh.
+    let volume = Volume::new(&vol.data, vol.dims).unwrap();
+    assert_eq!(
+        extract_par(&volume, &params, 3, &|_| {}).unwrap(),
+        mesh,
+        "{what}: 3 threads"
+    );
     assert_eq!(mesh.stats.t13, steps123.triangles.len() as u64, "{what}");
     assert_eq!(mesh.stats.triangles, mesh.triangles.len() as u64, "{what}");
     assert_eq!(mesh.stats.vertices, mesh.positions.len() as u64, "{what}");

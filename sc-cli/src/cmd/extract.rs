@@ -28,14 +28,6 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     if args.labels.is_some() {
         return super::labels::run(args, quiet);
     }
-    if args.stream && args.mode == Mode::Adaptive {
-        return Err(Error::Usage(
-            "--stream does not run --mode adaptive: the balancing of its boxes reads up to \
-             4 × --max-box + 2 slices past a slab (66 with boxes of 16), where the stream holds \
-             four; mesh the volume whole, or split it with --shards"
-                .into(),
-        ));
-    }
     let format = check_input(args, &options)?;
     let output = match (&args.output, &args.shards) {
         (_, Some(dir)) => return shards(args, dir, &options, quiet),
@@ -65,7 +57,15 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         Volume::Whole(grid) => {
             surface::extract_measured(grid, &request, args.stats_json.is_some(), &progress)?
         }
-        Volume::Streamed(stream) => (surface::extract_stream(stream, &request, &progress)?, None),
+        Volume::Streamed(stream) => {
+            if args.mode == Mode::Adaptive && args.stats_json.is_some() {
+                warn(
+                    "distance_to_steps123 is not measured on a streamed volume: it needs the \
+                     whole volume's Steps 1–3 mesh",
+                );
+            }
+            (surface::extract_stream(stream, &request, &progress)?, None)
+        }
     };
     let measure_time = distance.map(|(_, t)| t);
     let extract_time = clock.elapsed() - measure_time.unwrap_or_default();

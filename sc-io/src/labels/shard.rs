@@ -17,13 +17,13 @@ use sc_runtime::{Mode, Volume};
 use serde_json::{Value, json};
 
 use super::mesh::{self, LabelMeshes, LabelRequest, Selection};
-use super::stream::Joiner;
 use super::{Label, LabelTable};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::shard::{
     self, Header, MANIFEST_NAME, Manifest, ShardEntry, ShardFile, ShardSettings, put, rows,
 };
+use crate::slabs::Joiner;
 use crate::space::World;
 use crate::volume::{Dtype, Grid, Samples, cut};
 

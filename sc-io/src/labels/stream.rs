@@ -1,16 +1,13 @@
-//! Label volumes read a slab of z-slices at a time: each run of cube layers whose samples (with
-//! their halo) have been read is meshed as a block, and the blocks' shares are joined as they
-//! come, into exactly the atlas of the whole volume (docs/labels.md, "Blocks").
+//! Label volumes read a slab of z-slices at a time, meshed in blocks as they come
+//! ([`crate::slabs`]), into exactly the atlas of the whole volume (docs/labels.md, "Blocks").
 
-use std::ops::Range;
-
-use sc_runtime::labels::{Atlas, AtlasBlock, Label, LabelParams, block_samples, extract_block};
-use sc_runtime::{Error as RuntimeError, Volume};
+use sc_runtime::labels::{Atlas, Label, LabelParams};
 
 use super::mesh::{self, LabelMeshes, LabelRequest};
 use crate::error::Result;
 use crate::progress::Progress;
 use crate::read::stream::Stream;
+use crate::slabs::stream_blocks;
 use crate::space::World;
 use crate::volume::{Dtype, Sample};
 
@@ -65,105 +62,24 @@ where
     mesh::select(atlas, params.background, request)
 }
 
-/// The atlas of a volume of `dims` samples whose slabs of whole z-slices `next` gives in order:
-/// blocks of at least `block_layers` cube layers (all x and y), each meshed once the slices it
-/// reads are in, from a ring that keeps the slices later blocks read again and drops the rest.
+/// The atlas of a volume of `dims` samples whose slabs of whole z-slices `next` gives in order,
+/// meshed in blocks of at least `block_layers` cube layers ([`stream_blocks`]).
 fn stream_atlas<L: Label>(
     dims: [usize; 3],
     params: &LabelParams<L>,
     block_layers: usize,
-    mut next: impl FnMut() -> Result<Vec<L>>,
+    next: impl FnMut() -> Result<Vec<L>>,
     progress: &dyn Progress,
 ) -> Result<Atlas<L>> {
-    let [nx, ny, nz] = dims;
-    let nxy = nx * ny;
-    let cubes = dims.map(|n| (n + 2 * usize::from(params.pad)).saturating_sub(1));
-    let layers = if cubes.contains(&0) { 0 } else { cubes[2] };
-    let block = |z: Range<usize>| [0..cubes[0], 0..cubes[1], z];
-    // The slices `held` of the volume, x fastest.
-    let mut ring: Vec<L> = Vec::new();
-    let mut held = 0..0;
-    // Cube layers meshed, and those whose samples are all held.
-    let (mut done, mut ready) = (0, 0);
-    let mut shares = Joiner::default();
-    while held.end < nz || done < layers {
-        if held.end < nz {
-            let slab = next()?;
-            // Whole slices, at least one while any is left (the reader checked the dims are not
-            // zero); should a slab be empty, the blocks missing are reported below.
-            let slices = slab.len() / nxy;
-            debug_assert_eq!(slab.len(), slices * nxy);
-            if slices == 0 {
-                break;
-            }
-            ring.extend(slab);
-            held.end += slices;
-            progress.inc(slices as u64);
-        }
-        while ready < layers
-            && block_samples(dims, block(ready..ready + 1), params)?[2].end <= held.end
-        {
-            ready += 1;
-        }
-        if ready == done || (ready - done < block_layers && ready < layers) {
-            continue;
-        }
-        let cubes = block(done..ready);
-        let need = block_samples(dims, cubes.clone(), params)?[2].clone();
-        let from = (need.start - held.start) * nxy;
-        let samples = Volume::new(&ring[from..from + need.len() * nxy], [nx, ny, need.len()])?;
-        shares.push(extract_block(
-            samples,
-            [0, 0, need.start],
-            dims,
-            cubes,
-            params,
-        )?)?;
-        done = ready;
-        // Later blocks read from where the next one starts: the slices before are dropped.
-        if done < layers {
-            let keep = block_samples(dims, block(done..done + 1), params)?[2].start;
-            ring.drain(..(keep - held.start) * nxy);
-            held.start = keep;
-        }
-    }
-    Ok(shares.finish()?.into_atlas()?)
-}
-
-/// Shares joined as they come, like a binary counter: two joins of as many blocks each merge,
-/// so each share is copied about log₂(blocks) times rather than once per later block.
-pub(super) struct Joiner<L> {
-    /// Joined shares, with the blocks each holds, fewer blocks further up.
-    stack: Vec<(AtlasBlock<L>, usize)>,
-}
-
-impl<L> Default for Joiner<L> {
-    fn default() -> Self {
-        Joiner { stack: Vec::new() }
-    }
-}
-
-impl<L: Label> Joiner<L> {
-    pub(super) fn push(&mut self, share: AtlasBlock<L>) -> std::result::Result<(), RuntimeError> {
-        let mut top = (share, 1);
-        while let Some((below, blocks)) = self.stack.pop_if(|(_, blocks)| *blocks == top.1) {
-            top = (below.merge(top.0)?, blocks + top.1);
-        }
-        self.stack.push(top);
-        Ok(())
-    }
-
-    pub(super) fn finish(self) -> std::result::Result<AtlasBlock<L>, RuntimeError> {
-        AtlasBlock::merge_all(self.stack.into_iter().map(|(share, _)| share))
-    }
+    Ok(stream_blocks(params, dims, block_layers, next, progress)?.into_atlas()?)
 }
 
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
     use crate::progress::Silent;
-    use sc_runtime::Mode;
     use sc_runtime::labels::extract_labels;
+    use sc_runtime::{Mode, Volume};
 
     /// Labels of a volume with regions of every shape: cells around a few seeds, cut by noise
     /// in a band, so that the volume has junctions of three and more labels and merges.

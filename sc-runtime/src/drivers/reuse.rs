@@ -47,7 +47,7 @@ impl Extractor {
         params: &Params,
     ) -> Result<&Mesh, Error> {
         if params.mode == Mode::Adaptive {
-            self.mesh = super::adaptive::extract(volume, params)?;
+            self.mesh = super::adaptive::extract(volume, params, &super::adaptive::InOrder)?;
             return Ok(&self.mesh);
         }
         super::not_adaptive(params, "")?;
@@ -103,7 +103,7 @@ impl Extractor {
 /// ```
 pub fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
     if params.mode == Mode::Adaptive {
-        return super::adaptive::extract(volume, params);
+        return super::adaptive::extract(volume, params, &super::adaptive::InOrder);
     }
     super::not_adaptive(params, "")?;
     sweep(&Binary::new(params), volume, params)

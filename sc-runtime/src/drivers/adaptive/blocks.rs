@@ -10,7 +10,7 @@ use alloc::borrow::Cow;
 use alloc::vec::Vec;
 use core::ops::Range;
 
-use super::{LARGEST_BOX, run, unkey};
+use super::{InOrder, LARGEST_BOX, run, unkey};
 use crate::drivers::blocks::{BlockMesh, edge_key};
 use crate::drivers::keep_used;
 use crate::{Error, Params, Scalar, Stats, Volume};
@@ -80,7 +80,7 @@ pub(crate) fn extract_block<T: Scalar>(
         }
         Cow::Owned(cut)
     };
-    let run = run(&Volume::new(&data, dims)?, start, grid, params)?;
+    let run = run(&Volume::new(&data, dims)?, start, grid, params, &InOrder)?;
     let owned = |key: u64| {
         let c = unkey(key as usize, grid);
         (0..3).all(|d| cubes[d].contains(&c[d]))

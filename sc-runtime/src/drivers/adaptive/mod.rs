@@ -1,4 +1,5 @@
-//! Adaptive mode's driver: one thread, the volume in memory (docs/adaptive.md).
+//! Adaptive mode's driver: the volume in memory, its boxes decided and triangulated on one
+//! thread or several ([`Spread`]; docs/adaptive.md).
 //!
 //! 1. The Steps 1–3 mesh is swept as [`Mode::Steps123`](crate::Mode::Steps123) makes it, each
 //!    vertex named by its grid edge and each triangle by its cube ([`record`]).
@@ -16,6 +17,7 @@
 
 use alloc::vec;
 use alloc::vec::Vec;
+use core::ops::Range;
 
 use crate::drivers::borrowed::sweep_at;
 use crate::drivers::{has_cubes, keep_used};
@@ -72,11 +74,34 @@ struct PatchBuf {
     starts: Vec<u32>,
 }
 
-/// Extracts the adaptive mesh of `volume` (see the module's steps).
-pub(crate) fn extract<T: Scalar>(volume: &Volume<'_, T>, params: &Params) -> Result<Mesh, Error> {
+/// How the boxes of one size are shared out: in order on this thread ([`InOrder`]), or over a
+/// thread pool (`extract_par`). A box's decision reads its own samples, its Steps 1–3 triangles
+/// and the decisions on its children, and a box's triangles its own box and its neighbours'
+/// balanced sizes, so the mesh is the same however the boxes are shared out.
+pub(crate) trait Spread: Sync {
+    /// `f` on consecutive ranges that cover `0..n`, the results in the ranges' order.
+    fn ranges<R: Send>(&self, n: usize, f: impl Fn(Range<usize>) -> R + Sync) -> Vec<R>;
+}
+
+/// Every box on the calling thread.
+pub(crate) struct InOrder;
+
+impl Spread for InOrder {
+    fn ranges<R: Send>(&self, n: usize, f: impl Fn(Range<usize>) -> R + Sync) -> Vec<R> {
+        vec![f(0..n)]
+    }
+}
+
+/// Extracts the adaptive mesh of `volume` (see the module's steps), its boxes shared out by
+/// `spread`.
+pub(crate) fn extract<T: Scalar>(
+    volume: &Volume<'_, T>,
+    params: &Params,
+    spread: &impl Spread,
+) -> Result<Mesh, Error> {
     let dims = volume.dims();
     check(params, dims)?;
-    let run = run(volume, [0; 3], dims, params)?;
+    let run = run(volume, [0; 3], dims, params, spread)?;
     let mut mesh = run.rec.mesh;
     mesh.triangles = run.triangles;
     compact(&mut mesh);
@@ -114,6 +139,7 @@ fn run<T: Scalar>(
     at: [usize; 3],
     grid: [usize; 3],
     params: &Params,
+    spread: &impl Spread,
 ) -> Result<Run, Error> {
     let dims = volume.dims();
     let steps123 = Params {
@@ -155,12 +181,12 @@ fn run<T: Scalar>(
     };
     let merged = record(volume, at, &embedded, Recorded::without_positions(grid))?;
     let grid = Grid::new(volume, at, grid, params.iso, &rec);
-    let lattice = grid.decide(levels, &tolerance);
+    let lattice = grid.decide(levels, &tolerance, spread);
     let units = match lattice.first() {
         Some((pairs, _)) => {
             let mut level = final_levels(&lattice);
             balance(&mut level, *pairs, dims);
-            grid.emit(&lattice, &level, &tolerance, &merged)
+            grid.emit(&lattice, &level, &tolerance, &merged, spread)
         }
         None => grid.emit_units(&merged, |_| false, &tolerance),
     };
@@ -344,55 +370,70 @@ impl<'a, T: Scalar> Grid<'a, T> {
 
     /// Decides the boxes of every size up to `2^levels`, smallest first: a box is tested only if
     /// its eight children may all be boxes.
-    fn decide(&self, levels: usize, tolerance: &Tolerance) -> Lattice {
+    fn decide(&self, levels: usize, tolerance: &Tolerance, spread: &impl Spread) -> Lattice {
         let mut lattice: Lattice = Vec::new();
-        let mut buf = PatchBuf::default();
         for level in 1..=levels {
             let side = 1 << level;
             let cells = self.local.map(|d| (d - 1) / side);
-            // Whether a face has a box across is the whole grid's question: a box decides
-            // alike wherever its samples are at hand.
-            let grid_cells = self.dims.map(|d| (d - 1) / side);
             if cells.contains(&0) {
                 break;
             }
-            let mut states = vec![Cell::Cubes; cells.iter().product()];
-            for (i, state) in states.iter_mut().enumerate() {
-                let cell = unkey(i, cells);
-                if let Some((below, children)) = lattice.last() {
-                    let whole = (0..8).all(|k| {
-                        let child: [usize; 3] =
-                            core::array::from_fn(|d| 2 * cell[d] + (k >> d & 1));
-                        children[cell_index(child, *below)] != Cell::Cubes
-                    });
-                    if !whole {
-                        continue;
-                    }
-                }
-                let corner = self.corner(cell, side);
-                let global = corner.map(|c| c / side);
-                *state = match outline(self, corner, side) {
-                    Shape::Empty => Cell::Empty,
-                    Shape::Complex => Cell::Cubes,
-                    Shape::Simple(o) => {
-                        let may_chord = (0..o.n).fold(0u8, |m, i| {
-                            match neighbour(global, usize::from(o.arc_face[i]), grid_cells) {
-                                Some(_) => m | 1 << i,
-                                None => m,
-                            }
-                        });
-                        let patch = self.patch(corner, side, tolerance, &mut buf);
-                        if accept(self, &o, may_chord, &patch, tolerance) {
-                            Cell::Box
-                        } else {
-                            Cell::Cubes
-                        }
-                    }
-                };
-            }
+            let below = lattice.last();
+            let states = spread
+                .ranges(cells.iter().product(), |range| {
+                    let mut buf = PatchBuf::default();
+                    range
+                        .map(|i| self.decide_box(unkey(i, cells), side, below, tolerance, &mut buf))
+                        .collect::<Vec<Cell>>()
+                })
+                .concat();
             lattice.push((cells, states));
         }
         lattice
+    }
+
+    /// The decision on the box of `side` with local lattice index `cell`, given the decisions
+    /// on the boxes of half its side (`below`; none for the smallest).
+    fn decide_box(
+        &self,
+        cell: [usize; 3],
+        side: usize,
+        below: Option<&([usize; 3], Vec<Cell>)>,
+        tolerance: &Tolerance,
+        buf: &mut PatchBuf,
+    ) -> Cell {
+        if let Some((below, children)) = below {
+            let whole = (0..8).all(|k| {
+                let child: [usize; 3] = core::array::from_fn(|d| 2 * cell[d] + (k >> d & 1));
+                children[cell_index(child, *below)] != Cell::Cubes
+            });
+            if !whole {
+                return Cell::Cubes;
+            }
+        }
+        // Whether a face has a box across is the whole grid's question: a box decides alike
+        // wherever its samples are at hand.
+        let grid_cells = self.dims.map(|d| (d - 1) / side);
+        let corner = self.corner(cell, side);
+        let global = corner.map(|c| c / side);
+        match outline(self, corner, side) {
+            Shape::Empty => Cell::Empty,
+            Shape::Complex => Cell::Cubes,
+            Shape::Simple(o) => {
+                let may_chord = (0..o.n).fold(0u8, |m, i| {
+                    match neighbour(global, usize::from(o.arc_face[i]), grid_cells) {
+                        Some(_) => m | 1 << i,
+                        None => m,
+                    }
+                });
+                let patch = self.patch(corner, side, tolerance, buf);
+                if accept(self, &o, may_chord, &patch, tolerance) {
+                    Cell::Box
+                } else {
+                    Cell::Cubes
+                }
+            }
+        }
     }
 
     /// The triangles with their owners: those of unit cubes outside boxes, then each box's,
@@ -404,6 +445,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
         level: &[u8],
         tolerance: &Tolerance,
         merged: &Recorded,
+        spread: &impl Spread,
     ) -> Units {
         let pairs = lattice[0].0;
         let in_box = |cube_key: u64| -> bool {
@@ -412,45 +454,64 @@ impl<'a, T: Scalar> Grid<'a, T> {
             (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
         let mut out = self.emit_units(merged, in_box, tolerance);
-        let mut buf = PatchBuf::default();
         for (l, (cells, states)) in lattice.iter().enumerate() {
-            let (l, side) = (l as u8 + 1, 2usize << l);
-            for (i, &state) in states.iter().enumerate() {
-                let cell = unkey(i, *cells);
-                let first = cell.map(|c| c * (side / 2));
-                if state != Cell::Box || level[cell_index(first, pairs)] != l {
-                    continue;
+            let parts = spread.ranges(states.len(), |range| {
+                let (mut buf, mut triangles) = (PatchBuf::default(), Vec::new());
+                for i in range.filter(|&i| states[i] == Cell::Box) {
+                    let at = (unkey(i, *cells), l as u8 + 1);
+                    self.emit_box(at, level, pairs, tolerance, &mut buf, &mut triangles);
                 }
-                let corner = self.corner(cell, side);
-                let Shape::Simple(o) = outline(self, corner, side) else {
-                    continue;
-                };
-                // A face keeps its midline vertices unless a box at least as large is across.
-                let refined = (0..o.n).fold(0u8, |m, i| {
-                    let face = usize::from(o.arc_face[i]);
-                    match across(first, side / 2, face, pairs) {
-                        Some(j) if level[j] >= l => m,
-                        _ => m | 1 << i,
-                    }
-                });
-                let patch = self.patch(corner, side, tolerance, &mut buf);
-                // Accepted boxes triangulate in every variant (`accept`), and the choice
-                // depends on the box and its variant alone.
-                let Some(t) = triangulate(self, &o, refined, &patch, tolerance, &mut Memo::new())
-                else {
-                    debug_assert!(false, "an accepted box failed its variant");
-                    continue;
-                };
-                let owner = self.key(corner);
-                for tri in t.triangles() {
-                    let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
-                    if let [Some(a), Some(b), Some(c)] = ids {
-                        out.triangles.push((owner, [a, b, c]));
-                    }
-                }
+                triangles
+            });
+            for part in parts {
+                out.triangles.extend(part);
             }
         }
         out
+    }
+
+    /// Pushes the triangles of the accepted box with lattice index `cell` at level `l` (side
+    /// `2^l`), with their owner, if it is kept whole after balancing.
+    fn emit_box(
+        &self,
+        (cell, l): ([usize; 3], u8),
+        level: &[u8],
+        pairs: [usize; 3],
+        tolerance: &Tolerance,
+        buf: &mut PatchBuf,
+        out: &mut Vec<(u64, [u32; 3])>,
+    ) {
+        let side = 1usize << l;
+        let first = cell.map(|c| c * (side / 2));
+        if level[cell_index(first, pairs)] != l {
+            return;
+        }
+        let corner = self.corner(cell, side);
+        let Shape::Simple(o) = outline(self, corner, side) else {
+            return;
+        };
+        // A face keeps its midline vertices unless a box at least as large is across.
+        let refined = (0..o.n).fold(0u8, |m, i| {
+            let face = usize::from(o.arc_face[i]);
+            match across(first, side / 2, face, pairs) {
+                Some(j) if level[j] >= l => m,
+                _ => m | 1 << i,
+            }
+        });
+        let patch = self.patch(corner, side, tolerance, buf);
+        // Accepted boxes triangulate in every variant (`accept`), and the choice depends on the
+        // box and its variant alone.
+        let Some(t) = triangulate(self, &o, refined, &patch, tolerance, &mut Memo::new()) else {
+            debug_assert!(false, "an accepted box failed its variant");
+            return;
+        };
+        let owner = self.key(corner);
+        for tri in t.triangles() {
+            let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
+            if let [Some(a), Some(b), Some(c)] = ids {
+                out.push((owner, [a, b, c]));
+            }
+        }
     }
 
     /// The triangles of the unit cubes outside boxes, with embedded mode's merges where no box

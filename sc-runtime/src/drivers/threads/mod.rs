@@ -3,6 +3,7 @@
 mod claims;
 mod region;
 
+use std::ops::Range;
 use std::sync::Mutex;
 use std::time::Instant;
 use std::vec;
@@ -14,10 +15,10 @@ use claims::{Claims, Progress};
 use region::{Filled, Stretch};
 
 use crate::Mode;
-use crate::drivers::reuse;
 use crate::drivers::spare::SPARES;
 use crate::drivers::survey::{self, Survey};
 use crate::drivers::{InMemory, has_cubes};
+use crate::drivers::{adaptive, reuse};
 use crate::kernel::sink::Unsettled;
 use crate::kernel::{Binary, Engine, Layers};
 use crate::mesh::{OwnedScratch, push_to_columns, release_spare};
@@ -123,7 +124,12 @@ pub fn extract_par<T: Scalar>(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Mesh, Error> {
     if params.mode == Mode::Adaptive {
-        let mesh = super::adaptive::extract(volume, params)?;
+        let mesh = if threads == 1 {
+            adaptive::extract(volume, params, &adaptive::InOrder)?
+        } else {
+            let pool = pool_for(threads)?;
+            in_pool(pool.as_ref(), || adaptive::extract(volume, params, &OnPool))?
+        };
         progress(volume.dims()[2].saturating_sub(1));
         return Ok(mesh);
     }
@@ -149,18 +155,7 @@ pub(crate) fn sweep_par<T: Scalar>(
         progress(dims[2] - 1);
         return Ok(mesh);
     }
-    // Rayon's global pool when it has the threads asked for: building a pool starts threads,
-    // which costs a noticeable share of a small volume's extraction.
-    let own_pool = if threads == 0 || threads == rayon::current_num_threads() {
-        None
-    } else {
-        Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .map_err(|_| Error::ThreadPool)?,
-        )
-    };
+    let own_pool = pool_for(threads)?;
     let layers = dims[2] - 1;
     let workers = own_pool
         .as_ref()
@@ -349,6 +344,35 @@ fn cut(work: &[usize], (did, seconds): (usize, f64), p: &Progress) -> Option<usi
     // The first layer from which the tail's work is at most the thief's share.
     let at = from + work[from..p.end].partition_point(|&w| (work[p.end] - w) as f64 > share);
     (at + MIN_TAIL <= p.end).then_some(at)
+}
+
+/// A pool of `threads` threads (0 = all cores), or none when rayon's global pool has that many:
+/// building a pool starts threads, which costs a noticeable share of a small volume's
+/// extraction.
+fn pool_for(threads: usize) -> Result<Option<rayon::ThreadPool>, Error> {
+    if threads == 0 || threads == rayon::current_num_threads() {
+        return Ok(None);
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map(Some)
+        .map_err(|_| Error::ThreadPool)
+}
+
+/// Adaptive mode's boxes shared out over the current pool, in ranges of at least 64 boxes and
+/// some 16 per thread: boxes differ widely in cost (most are empty), so many ranges balance the
+/// work, and each range reuses one buffer.
+struct OnPool;
+
+impl adaptive::Spread for OnPool {
+    fn ranges<R: Send>(&self, n: usize, f: impl Fn(Range<usize>) -> R + Sync) -> Vec<R> {
+        let chunk = n.div_ceil(16 * rayon::current_num_threads()).max(64);
+        (0..n.div_ceil(chunk))
+            .into_par_iter()
+            .map(|k| f(k * chunk..n.min((k + 1) * chunk)))
+            .collect()
+    }
 }
 
 /// Runs `job` in `pool`, or in rayon's global pool (which has the threads asked for) when there
