@@ -452,46 +452,51 @@ pub(crate) fn within(t: [[f64; 3]; 3], others: &(impl Nearby + ?Sized), limit: f
     if limit.is_nan() || limit <= 0.0 || tris.is_empty() {
         return false;
     }
+    let mut last = 0;
+    covered(t, 0, others, limit, &mut last)
+}
+
+/// Whether every point of `piece`, at split depth `depth`, lies within `limit` of one of
+/// `others` ([`within`]). `last` is the triangle that covered the last piece: neighbouring pieces
+/// are usually near the same one, so it is tried first. Depth first, the middle piece before the
+/// corners', by recursion rather than an explicit stack: most pieces are covered whole at once,
+/// and a stack for every depth would be cleared on each call for nothing.
+fn covered(
+    piece: [[f64; 3]; 3],
+    depth: usize,
+    others: &(impl Nearby + ?Sized),
+    limit: f64,
+    last: &mut usize,
+) -> bool {
+    let tris = others.tris();
     let limit2 = limit * limit;
-    let mid = |a: [f64; 3], b: [f64; 3]| core::array::from_fn(|d| 0.5 * (a[d] + b[d]));
     let grown = |lo: [f64; 3], hi: [f64; 3]| -> ([f64; 3], [f64; 3]) {
         (lo.map(|c| c - limit), hi.map(|c| c + limit))
     };
-    // Depth-first: at most three pieces wait per level.
-    let mut stack = [([[0.0; 3]; 3], 0usize); 3 * MAX_DEPTH + 1];
-    stack[0] = (t, 0);
-    let mut waiting = 1;
-    // Neighbouring pieces are usually near the same triangle: try the last one that covered.
-    let mut last = 0;
-    while waiting > 0 {
-        waiting -= 1;
-        let (piece, depth) = stack[waiting];
-        let covers = |k: usize| piece.iter().all(|&p| near(p, &tris[k], limit2));
-        if covers(last) {
-            continue;
-        }
-        let lo = core::array::from_fn(|d| piece[0][d].min(piece[1][d]).min(piece[2][d]));
-        let hi = core::array::from_fn(|d| piece[0][d].max(piece[1][d]).max(piece[2][d]));
-        let (lo, hi) = grown(lo, hi);
-        if let Some(k) = others.find(lo, hi, covers) {
-            last = k;
-            continue;
-        }
-        let reached = |p: [f64; 3]| {
-            let (lo, hi) = grown(p, p);
-            others.find(lo, hi, |k| near(p, &tris[k], limit2)).is_some()
-        };
-        if depth == MAX_DEPTH || !piece.iter().all(|&p| reached(p)) {
-            return false;
-        }
-        let [a, b, c] = piece;
-        let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-        for q in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
-            stack[waiting] = (q, depth + 1);
-            waiting += 1;
-        }
+    let covers = |k: usize| piece.iter().all(|&p| near(p, &tris[k], limit2));
+    if covers(*last) {
+        return true;
     }
-    true
+    let lo = core::array::from_fn(|d| piece[0][d].min(piece[1][d]).min(piece[2][d]));
+    let hi = core::array::from_fn(|d| piece[0][d].max(piece[1][d]).max(piece[2][d]));
+    let (lo, hi) = grown(lo, hi);
+    if let Some(k) = others.find(lo, hi, covers) {
+        *last = k;
+        return true;
+    }
+    let reached = |p: [f64; 3]| {
+        let (lo, hi) = grown(p, p);
+        others.find(lo, hi, |k| near(p, &tris[k], limit2)).is_some()
+    };
+    if depth == MAX_DEPTH || !piece.iter().all(|&p| reached(p)) {
+        return false;
+    }
+    let mid = |a: [f64; 3], b: [f64; 3]| core::array::from_fn(|d| 0.5 * (a[d] + b[d]));
+    let [a, b, c] = piece;
+    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+    [[ab, bc, ca], [ca, bc, c], [ab, b, bc], [a, ab, ca]]
+        .into_iter()
+        .all(|q| covered(q, depth + 1, others, limit, last))
 }
 
 /// Whether `p` lies within `√limit2` of triangle `o`; its bounding box rules most triangles out
