@@ -340,9 +340,15 @@ pub(crate) fn within_bound(
         ours[i] = t.map(|v| scaled(v.p, tolerance));
     }
     let ours = &ours[..tris.len()];
+    // Steps 1–3's triangles come cube by cube, so the one of ours that covered a triangle
+    // likely covers the next: it is tried first ([`within_from`]).
+    let mut last = 0;
     ours.iter()
         .all(|&t| memo.get_or(t, || within(t, patch, tolerance.limit)))
-        && patch.tris.iter().all(|&t| within(t, ours, tolerance.limit))
+        && patch
+            .tris
+            .iter()
+            .all(|&t| within_from(t, ours, tolerance.limit, &mut last))
 }
 
 /// Which of a box's triangles lie within the bound of its patch, remembered while the box is
@@ -452,8 +458,20 @@ pub(crate) fn within(t: [[f64; 3]; 3], others: &(impl Nearby + ?Sized), limit: f
     if limit.is_nan() || limit <= 0.0 || tris.is_empty() {
         return false;
     }
-    let mut last = 0;
-    covered(t, 0, others, limit, &mut last)
+    covered(t, 0, others, limit, &mut 0)
+}
+
+/// [`within`] against a slice of triangles, trying `others[*last]` first and leaving there the
+/// last one that covered a piece. A slice's `find` tries every triangle, so a piece is covered
+/// iff some triangle covers it, whichever is tried first: the answer is [`within`]'s.
+fn within_from(t: [[f64; 3]; 3], others: &[[[f64; 3]; 3]], limit: f64, last: &mut usize) -> bool {
+    if limit.is_nan() || limit <= 0.0 || others.is_empty() {
+        return false;
+    }
+    if *last >= others.len() {
+        *last = 0;
+    }
+    covered(t, 0, others, limit, last)
 }
 
 /// Whether every point of `piece`, at split depth `depth`, lies within `limit` of one of
