@@ -573,6 +573,10 @@ fn unkey(i: usize, dims: [usize; 3]) -> [usize; 3] {
 }
 
 impl<T: Scalar> BoxSource for Grid<'_, T> {
+    fn filled(&self, p: [usize; 3]) -> bool {
+        self.sample(p).filled(self.threshold)
+    }
+
     fn crossing(&self, lower: [usize; 3], axis: usize) -> Option<Crossing> {
         let mut upper = lower;
         upper[axis] += 1;
@@ -580,7 +584,6 @@ impl<T: Scalar> BoxSource for Grid<'_, T> {
         let (fa, fb) = (a.filled(self.threshold), b.filled(self.threshold));
         (fa != fb).then(|| Crossing {
             t: sample_crossing(a, b, self.iso),
-            lower_filled: fa,
         })
     }
 

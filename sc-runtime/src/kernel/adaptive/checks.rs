@@ -134,9 +134,12 @@ pub(crate) fn separates(
                     continue;
                 }
                 // The line's occupied edge, if any ((S): at most one).
+                let mut below = src.filled(on_line(corner, axis, [u, v], 0));
                 let want = (0..side).find_map(|k| {
-                    let lower = on_line(corner, axis, [u, v], k);
-                    src.crossing(lower, axis).map(|_| lower[axis])
+                    let above = src.filled(on_line(corner, axis, [u, v], k + 1));
+                    let occupied = below != above;
+                    below = above;
+                    occupied.then_some(corner[axis] + k)
                 });
                 let at = [(corner[o1] + u) as f64, (corner[o2] + v) as f64];
                 let mut hits = [0.0; 2];
