@@ -20,7 +20,7 @@ use alloc::vec::Vec;
 use crate::drivers::borrowed::sweep_at;
 use crate::drivers::{has_cubes, keep_used};
 use crate::kernel::Binary;
-use crate::kernel::adaptive::checks::{Memo, scaled};
+use crate::kernel::adaptive::checks::{Memo, bounds, scaled};
 use crate::kernel::adaptive::outline::Shape;
 use crate::kernel::adaptive::{
     BoxSource, Crossing, Patch, Tolerance, Vertex, accept, outline, triangulate,
@@ -69,6 +69,7 @@ pub(crate) fn check(params: &Params, dims: [usize; 3]) -> Result<(), Error> {
 #[derive(Default)]
 struct PatchBuf {
     tris: Vec<[[f64; 3]; 3]>,
+    boxes: Vec<[[f64; 3]; 2]>,
     starts: Vec<u32>,
 }
 
@@ -333,8 +334,11 @@ impl<'a, T: Scalar> Grid<'a, T> {
             }
         }
         buf.starts.push(buf.tris.len() as u32);
+        buf.boxes.clear();
+        buf.boxes.extend(buf.tris.iter().map(bounds));
         Patch {
             tris: &buf.tris,
+            boxes: &buf.boxes,
             starts: &buf.starts,
             corner,
             side,

@@ -348,10 +348,34 @@ pub(crate) fn within_bound(
     let mut last = 0;
     ours.iter()
         .all(|&t| memo.get_or(t, || within(t, patch, tolerance.limit)))
-        && patch
-            .tris
-            .iter()
-            .all(|&t| within_from(t, ours, tolerance.limit, &mut last))
+        && {
+            let mut boxes = [[[0.0; 3]; 2]; super::MAX_TRIANGLES];
+            for (b, t) in boxes.iter_mut().zip(ours) {
+                *b = bounds(t);
+            }
+            let ours = Boxed {
+                tris: ours,
+                boxes: &boxes[..ours.len()],
+            };
+            patch
+                .tris
+                .iter()
+                .all(|&t| within_from(t, &ours, tolerance.limit, &mut last))
+        }
+}
+
+/// A triangle's bounding box: its lower and upper corner.
+pub(crate) fn bounds(t: &[[f64; 3]; 3]) -> [[f64; 3]; 2] {
+    [
+        core::array::from_fn(|d| t[0][d].min(t[1][d]).min(t[2][d])),
+        core::array::from_fn(|d| t[0][d].max(t[1][d]).max(t[2][d])),
+    ]
+}
+
+/// A few triangles with their bounding boxes, searched whole.
+struct Boxed<'a> {
+    tris: &'a [[[f64; 3]; 3]],
+    boxes: &'a [[[f64; 3]; 2]],
 }
 
 /// Which of a box's triangles lie within the bound of its patch, remembered while the box is
@@ -392,6 +416,8 @@ impl Memo {
 pub(crate) trait Nearby {
     /// All of them.
     fn tris(&self) -> &[[[f64; 3]; 3]];
+    /// Triangle `k`'s bounding box ([`bounds`]).
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2];
     /// The first index, among the triangles that may meet the box `lo ..= hi`, for which `f`
     /// holds.
     fn find(&self, lo: [f64; 3], hi: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize>;
@@ -402,14 +428,36 @@ impl Nearby for [[[f64; 3]; 3]] {
         self
     }
 
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
+        bounds(&self[k])
+    }
+
     fn find(&self, _: [f64; 3], _: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize> {
         (0..self.len()).position(f)
+    }
+}
+
+impl Nearby for Boxed<'_> {
+    fn tris(&self) -> &[[[f64; 3]; 3]] {
+        self.tris
+    }
+
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
+        self.boxes[k]
+    }
+
+    fn find(&self, _: [f64; 3], _: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize> {
+        (0..self.tris.len()).position(f)
     }
 }
 
 impl Nearby for Patch<'_> {
     fn tris(&self) -> &[[[f64; 3]; 3]] {
         self.tris
+    }
+
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
+        self.boxes[k]
     }
 
     /// Only the cubes whose closed box meets `lo ..= hi`: a Steps 1–3 triangle lies in its cube.
@@ -464,14 +512,14 @@ pub(crate) fn within(t: [[f64; 3]; 3], others: &(impl Nearby + ?Sized), limit: f
     covered(t, 0, others, limit, &mut 0)
 }
 
-/// [`within`] against a slice of triangles, trying `others[*last]` first and leaving there the
-/// last one that covered a piece. A slice's `find` tries every triangle, so a piece is covered
+/// [`within`] against a few triangles, trying `others[*last]` first and leaving there the
+/// last one that covered a piece. Their `find` tries every triangle, so a piece is covered
 /// iff some triangle covers it, whichever is tried first: the answer is [`within`]'s.
-fn within_from(t: [[f64; 3]; 3], others: &[[[f64; 3]; 3]], limit: f64, last: &mut usize) -> bool {
-    if limit.is_nan() || limit <= 0.0 || others.is_empty() {
+fn within_from(t: [[f64; 3]; 3], others: &Boxed<'_>, limit: f64, last: &mut usize) -> bool {
+    if limit.is_nan() || limit <= 0.0 || others.tris.is_empty() {
         return false;
     }
-    if *last >= others.len() {
+    if *last >= others.tris.len() {
         *last = 0;
     }
     covered(t, 0, others, limit, last)
@@ -494,7 +542,14 @@ fn covered(
     let grown = |lo: [f64; 3], hi: [f64; 3]| -> ([f64; 3], [f64; 3]) {
         (lo.map(|c| c - limit), hi.map(|c| c + limit))
     };
-    let covers = |k: usize| piece.iter().all(|&p| near(p, &tris[k], limit2));
+    // Every corner's cheap test before any exact distance: the same conjunction.
+    let covers = |k: usize| {
+        let b = others.bounds(k);
+        piece.iter().all(|&p| box_near(p, &b, limit2))
+            && piece
+                .iter()
+                .all(|&p| point_triangle_distance_squared(p, tris[k]) <= limit2)
+    };
     if covers(*last) {
         return true;
     }
@@ -507,7 +562,12 @@ fn covered(
     }
     let reached = |p: [f64; 3]| {
         let (lo, hi) = grown(p, p);
-        others.find(lo, hi, |k| near(p, &tris[k], limit2)).is_some()
+        others
+            .find(lo, hi, |k| {
+                box_near(p, &others.bounds(k), limit2)
+                    && point_triangle_distance_squared(p, tris[k]) <= limit2
+            })
+            .is_some()
     };
     if depth == MAX_DEPTH || !piece.iter().all(|&p| reached(p)) {
         return false;
@@ -520,18 +580,16 @@ fn covered(
         .all(|q| covered(q, depth + 1, others, limit, last))
 }
 
-/// Whether `p` lies within `√limit2` of triangle `o`; its bounding box rules most triangles out
-/// at a fraction of the exact distance's cost.
+/// Whether `p` lies within `√limit2` of bounding box `b`: a triangle inside it can be that near
+/// only then, and the test rules most triangles out at a fraction of the exact distance's cost.
 #[inline]
-fn near(p: [f64; 3], o: &[[f64; 3]; 3], limit2: f64) -> bool {
+fn box_near(p: [f64; 3], [lo, hi]: &[[f64; 3]; 2], limit2: f64) -> bool {
     let mut outside2 = 0.0;
     for d in 0..3 {
-        let lo = o[0][d].min(o[1][d]).min(o[2][d]);
-        let hi = o[0][d].max(o[1][d]).max(o[2][d]);
-        let gap = (lo - p[d]).max(p[d] - hi).max(0.0);
+        let gap = (lo[d] - p[d]).max(p[d] - hi[d]).max(0.0);
         outside2 += gap * gap;
     }
-    outside2 <= limit2 && point_triangle_distance_squared(p, *o) <= limit2
+    outside2 <= limit2
 }
 
 /// The shape of a triangle, from 0 (degenerate) to 1 (equilateral): `48 · area² / (Σ side²)²`.

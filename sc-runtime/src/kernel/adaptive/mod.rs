@@ -90,6 +90,8 @@ impl Vertex {
 pub(crate) struct Patch<'a> {
     /// The triangles, cube by cube.
     pub tris: &'a [[[f64; 3]; 3]],
+    /// Each triangle's bounding box, lower and upper corner ([`checks::bounds`]).
+    pub boxes: &'a [[[f64; 3]; 2]],
     /// Cube `c`'s triangles are `tris[starts[c]..starts[c + 1]]`, `c = x + side · (y + side · z)`
     /// in cubes from the box's corner.
     pub starts: &'a [u32],
