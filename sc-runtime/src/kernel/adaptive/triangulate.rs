@@ -80,14 +80,34 @@ fn refined_boundary(
         let (x, y) = (usize::from(tri[s]), usize::from(tri[(s + 1) % 3]));
         out[m] = outline.corners[x];
         m += 1;
-        if (x + 1) % outline.n == y && refined >> x & 1 == 1 {
-            for &w in &outline.mids[x][..usize::from(outline.mid_count[x])] {
-                out[m] = w;
-                m += 1;
-            }
+        for &w in side_mids(outline, refined, x, y) {
+            out[m] = w;
+            m += 1;
         }
     }
     (out, m)
+}
+
+/// The kept midline vertices on side `x → y` of a coarse triangle: those of arc `x`, if the
+/// side is that arc and the variant keeps them.
+fn side_mids(outline: &Outline, refined: u8, x: usize, y: usize) -> &[Vertex] {
+    if (x + 1) % outline.n == y && refined >> x & 1 == 1 {
+        &outline.mids[x][..usize::from(outline.mid_count[x])]
+    } else {
+        &[]
+    }
+}
+
+/// How many triangles coarse triangle `tri`'s fan has: one, and one per kept midline vertex on
+/// its sides ([`refined_boundary`]'s length less two).
+fn fan_size(outline: &Outline, refined: u8, tri: [u8; 3]) -> usize {
+    (0..3)
+        .map(|s| {
+            let (x, y) = (usize::from(tri[s]), usize::from(tri[(s + 1) % 3]));
+            side_mids(outline, refined, x, y).len()
+        })
+        .sum::<usize>()
+        + 1
 }
 
 /// The best fan of a small polygon whose triangles all face up and none lies in a face: its
@@ -166,7 +186,7 @@ impl<'o> Fans<'o> {
         for &tri in coarse {
             let (_, w) = self.get(tri)?;
             worst = worst.min(w);
-            count += refined_boundary(self.outline, self.refined, tri).1 - 2;
+            count += fan_size(self.outline, self.refined, tri);
         }
         (count <= MAX_TRIANGLES).then_some(worst)
     }
