@@ -336,13 +336,9 @@ impl<'a, T: Scalar> Grid<'a, T> {
         buf.starts.push(buf.tris.len() as u32);
         buf.boxes.clear();
         buf.boxes.extend(buf.tris.iter().map(bounds));
-        let span = buf.boxes.iter().fold([0.0f64; 3], |w, [lo, hi]| {
-            core::array::from_fn(|d| w[d].max(hi[d] - lo[d]))
-        });
         Patch {
             tris: &buf.tris,
             boxes: &buf.boxes,
-            span,
             starts: &buf.starts,
             corner,
             side,

@@ -418,10 +418,6 @@ pub(crate) trait Nearby {
     fn tris(&self) -> &[[[f64; 3]; 3]];
     /// Triangle `k`'s bounding box ([`bounds`]).
     fn bounds(&self, k: usize) -> [[f64; 3]; 2];
-    /// No triangle's bounding box is wider along axis `d` than `span()[d]`.
-    fn span(&self) -> [f64; 3] {
-        [f64::INFINITY; 3]
-    }
     /// The first index, among the triangles that may meet the box `lo ..= hi`, for which `f`
     /// holds.
     fn find(&self, lo: [f64; 3], hi: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize>;
@@ -462,10 +458,6 @@ impl Nearby for Patch<'_> {
 
     fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
         self.boxes[k]
-    }
-
-    fn span(&self) -> [f64; 3] {
-        self.span
     }
 
     /// Only the cubes whose closed box meets `lo ..= hi`: a Steps 1–3 triangle lies in its cube.
@@ -558,24 +550,15 @@ fn covered(
                 .iter()
                 .all(|&p| point_triangle_distance_squared(p, tris[k]) <= limit2)
     };
-    let [lo, hi] = bounds(&piece);
-    // A triangle covers the piece only if the piece's box lies in the triangle's grown by the
-    // limit: a piece wider than every triangle by more than twice the limit (and a margin far
-    // above rounding) is covered by none, and is split without a search.
-    let span = others.span();
-    let may_cover = (0..3).all(|d| {
-        let most = span[d] + 2.0 * limit;
-        hi[d] - lo[d] <= most + 1e-6 * (1.0 + most)
-    });
-    if may_cover {
-        if covers(*last) {
-            return true;
-        }
-        let (lo, hi) = grown(lo, hi);
-        if let Some(k) = others.find(lo, hi, covers) {
-            *last = k;
-            return true;
-        }
+    if covers(*last) {
+        return true;
+    }
+    let lo = core::array::from_fn(|d| piece[0][d].min(piece[1][d]).min(piece[2][d]));
+    let hi = core::array::from_fn(|d| piece[0][d].max(piece[1][d]).max(piece[2][d]));
+    let (lo, hi) = grown(lo, hi);
+    if let Some(k) = others.find(lo, hi, covers) {
+        *last = k;
+        return true;
     }
     let reached = |p: [f64; 3]| {
         let (lo, hi) = grown(p, p);

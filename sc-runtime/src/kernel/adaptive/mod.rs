@@ -92,8 +92,6 @@ pub(crate) struct Patch<'a> {
     pub tris: &'a [[[f64; 3]; 3]],
     /// Each triangle's bounding box, lower and upper corner ([`checks::bounds`]).
     pub boxes: &'a [[[f64; 3]; 2]],
-    /// The widest of those boxes along each axis.
-    pub span: [f64; 3],
     /// Cube `c`'s triangles are `tris[starts[c]..starts[c + 1]]`, `c = x + side · (y + side · z)`
     /// in cubes from the box's corner.
     pub starts: &'a [u32],
