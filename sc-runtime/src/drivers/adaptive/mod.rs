@@ -22,7 +22,7 @@ use core::ops::Range;
 use crate::drivers::borrowed::sweep_at;
 use crate::drivers::{has_cubes, keep_used};
 use crate::kernel::Binary;
-use crate::kernel::adaptive::checks::{Memo, scaled};
+use crate::kernel::adaptive::checks::{Memo, bounds, scaled};
 use crate::kernel::adaptive::outline::Shape;
 use crate::kernel::adaptive::{
     BoxSource, Crossing, Patch, Tolerance, Vertex, accept, outline, triangulate,
@@ -71,6 +71,7 @@ pub(crate) fn check(params: &Params, dims: [usize; 3]) -> Result<(), Error> {
 #[derive(Default)]
 struct PatchBuf {
     tris: Vec<[[f64; 3]; 3]>,
+    boxes: Vec<[[f64; 3]; 2]>,
     starts: Vec<u32>,
 }
 
@@ -359,8 +360,11 @@ impl<'a, T: Scalar> Grid<'a, T> {
             }
         }
         buf.starts.push(buf.tris.len() as u32);
+        buf.boxes.clear();
+        buf.boxes.extend(buf.tris.iter().map(bounds));
         Patch {
             tris: &buf.tris,
+            boxes: &buf.boxes,
             starts: &buf.starts,
             corner,
             side,
@@ -634,6 +638,10 @@ fn unkey(i: usize, dims: [usize; 3]) -> [usize; 3] {
 }
 
 impl<T: Scalar> BoxSource for Grid<'_, T> {
+    fn filled(&self, p: [usize; 3]) -> bool {
+        self.sample(p).filled(self.threshold)
+    }
+
     fn crossing(&self, lower: [usize; 3], axis: usize) -> Option<Crossing> {
         let mut upper = lower;
         upper[axis] += 1;
@@ -641,7 +649,6 @@ impl<T: Scalar> BoxSource for Grid<'_, T> {
         let (fa, fb) = (a.filled(self.threshold), b.filled(self.threshold));
         (fa != fb).then(|| Crossing {
             t: sample_crossing(a, b, self.iso),
-            lower_filled: fa,
         })
     }
 

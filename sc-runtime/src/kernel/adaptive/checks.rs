@@ -134,9 +134,12 @@ pub(crate) fn separates(
                     continue;
                 }
                 // The line's occupied edge, if any ((S): at most one).
+                let mut below = src.filled(on_line(corner, axis, [u, v], 0));
                 let want = (0..side).find_map(|k| {
-                    let lower = on_line(corner, axis, [u, v], k);
-                    src.crossing(lower, axis).map(|_| lower[axis])
+                    let above = src.filled(on_line(corner, axis, [u, v], k + 1));
+                    let occupied = below != above;
+                    below = above;
+                    occupied.then_some(corner[axis] + k)
                 });
                 let at = [(corner[o1] + u) as f64, (corner[o2] + v) as f64];
                 let mut hits = [0.0; 2];
@@ -340,9 +343,39 @@ pub(crate) fn within_bound(
         ours[i] = t.map(|v| scaled(v.p, tolerance));
     }
     let ours = &ours[..tris.len()];
+    // Steps 1–3's triangles come cube by cube, so the one of ours that covered a triangle
+    // likely covers the next: it is tried first ([`within_from`]).
+    let mut last = 0;
     ours.iter()
         .all(|&t| memo.get_or(t, || within(t, patch, tolerance.limit)))
-        && patch.tris.iter().all(|&t| within(t, ours, tolerance.limit))
+        && {
+            let mut boxes = [[[0.0; 3]; 2]; super::MAX_TRIANGLES];
+            for (b, t) in boxes.iter_mut().zip(ours) {
+                *b = bounds(t);
+            }
+            let ours = Boxed {
+                tris: ours,
+                boxes: &boxes[..ours.len()],
+            };
+            patch
+                .tris
+                .iter()
+                .all(|&t| within_from(t, &ours, tolerance.limit, &mut last))
+        }
+}
+
+/// A triangle's bounding box: its lower and upper corner.
+pub(crate) fn bounds(t: &[[f64; 3]; 3]) -> [[f64; 3]; 2] {
+    [
+        core::array::from_fn(|d| t[0][d].min(t[1][d]).min(t[2][d])),
+        core::array::from_fn(|d| t[0][d].max(t[1][d]).max(t[2][d])),
+    ]
+}
+
+/// A few triangles with their bounding boxes, searched whole.
+struct Boxed<'a> {
+    tris: &'a [[[f64; 3]; 3]],
+    boxes: &'a [[[f64; 3]; 2]],
 }
 
 /// Which of a box's triangles lie within the bound of its patch, remembered while the box is
@@ -383,6 +416,8 @@ impl Memo {
 pub(crate) trait Nearby {
     /// All of them.
     fn tris(&self) -> &[[[f64; 3]; 3]];
+    /// Triangle `k`'s bounding box ([`bounds`]).
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2];
     /// The first index, among the triangles that may meet the box `lo ..= hi`, for which `f`
     /// holds.
     fn find(&self, lo: [f64; 3], hi: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize>;
@@ -393,14 +428,36 @@ impl Nearby for [[[f64; 3]; 3]] {
         self
     }
 
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
+        bounds(&self[k])
+    }
+
     fn find(&self, _: [f64; 3], _: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize> {
         (0..self.len()).position(f)
+    }
+}
+
+impl Nearby for Boxed<'_> {
+    fn tris(&self) -> &[[[f64; 3]; 3]] {
+        self.tris
+    }
+
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
+        self.boxes[k]
+    }
+
+    fn find(&self, _: [f64; 3], _: [f64; 3], f: impl FnMut(usize) -> bool) -> Option<usize> {
+        (0..self.tris.len()).position(f)
     }
 }
 
 impl Nearby for Patch<'_> {
     fn tris(&self) -> &[[[f64; 3]; 3]] {
         self.tris
+    }
+
+    fn bounds(&self, k: usize) -> [[f64; 3]; 2] {
+        self.boxes[k]
     }
 
     /// Only the cubes whose closed box meets `lo ..= hi`: a Steps 1–3 triangle lies in its cube.
@@ -452,60 +509,87 @@ pub(crate) fn within(t: [[f64; 3]; 3], others: &(impl Nearby + ?Sized), limit: f
     if limit.is_nan() || limit <= 0.0 || tris.is_empty() {
         return false;
     }
+    covered(t, 0, others, limit, &mut 0)
+}
+
+/// [`within`] against a few triangles, trying `others[*last]` first and leaving there the
+/// last one that covered a piece. Their `find` tries every triangle, so a piece is covered
+/// iff some triangle covers it, whichever is tried first: the answer is [`within`]'s.
+fn within_from(t: [[f64; 3]; 3], others: &Boxed<'_>, limit: f64, last: &mut usize) -> bool {
+    if limit.is_nan() || limit <= 0.0 || others.tris.is_empty() {
+        return false;
+    }
+    if *last >= others.tris.len() {
+        *last = 0;
+    }
+    covered(t, 0, others, limit, last)
+}
+
+/// Whether every point of `piece`, at split depth `depth`, lies within `limit` of one of
+/// `others` ([`within`]). `last` is the triangle that covered the last piece: neighbouring pieces
+/// are usually near the same one, so it is tried first. Depth first, the middle piece before the
+/// corners', by recursion rather than an explicit stack: most pieces are covered whole at once,
+/// and a stack for every depth would be cleared on each call for nothing.
+fn covered(
+    piece: [[f64; 3]; 3],
+    depth: usize,
+    others: &(impl Nearby + ?Sized),
+    limit: f64,
+    last: &mut usize,
+) -> bool {
+    let tris = others.tris();
     let limit2 = limit * limit;
-    let mid = |a: [f64; 3], b: [f64; 3]| core::array::from_fn(|d| 0.5 * (a[d] + b[d]));
     let grown = |lo: [f64; 3], hi: [f64; 3]| -> ([f64; 3], [f64; 3]) {
         (lo.map(|c| c - limit), hi.map(|c| c + limit))
     };
-    // Depth-first: at most three pieces wait per level.
-    let mut stack = [([[0.0; 3]; 3], 0usize); 3 * MAX_DEPTH + 1];
-    stack[0] = (t, 0);
-    let mut waiting = 1;
-    // Neighbouring pieces are usually near the same triangle: try the last one that covered.
-    let mut last = 0;
-    while waiting > 0 {
-        waiting -= 1;
-        let (piece, depth) = stack[waiting];
-        let covers = |k: usize| piece.iter().all(|&p| near(p, &tris[k], limit2));
-        if covers(last) {
-            continue;
-        }
-        let lo = core::array::from_fn(|d| piece[0][d].min(piece[1][d]).min(piece[2][d]));
-        let hi = core::array::from_fn(|d| piece[0][d].max(piece[1][d]).max(piece[2][d]));
-        let (lo, hi) = grown(lo, hi);
-        if let Some(k) = others.find(lo, hi, covers) {
-            last = k;
-            continue;
-        }
-        let reached = |p: [f64; 3]| {
-            let (lo, hi) = grown(p, p);
-            others.find(lo, hi, |k| near(p, &tris[k], limit2)).is_some()
-        };
-        if depth == MAX_DEPTH || !piece.iter().all(|&p| reached(p)) {
-            return false;
-        }
-        let [a, b, c] = piece;
-        let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-        for q in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
-            stack[waiting] = (q, depth + 1);
-            waiting += 1;
-        }
+    // Every corner's cheap test before any exact distance: the same conjunction.
+    let covers = |k: usize| {
+        let b = others.bounds(k);
+        piece.iter().all(|&p| box_near(p, &b, limit2))
+            && piece
+                .iter()
+                .all(|&p| point_triangle_distance_squared(p, tris[k]) <= limit2)
+    };
+    if covers(*last) {
+        return true;
     }
-    true
+    let lo = core::array::from_fn(|d| piece[0][d].min(piece[1][d]).min(piece[2][d]));
+    let hi = core::array::from_fn(|d| piece[0][d].max(piece[1][d]).max(piece[2][d]));
+    let (lo, hi) = grown(lo, hi);
+    if let Some(k) = others.find(lo, hi, covers) {
+        *last = k;
+        return true;
+    }
+    let reached = |p: [f64; 3]| {
+        let (lo, hi) = grown(p, p);
+        others
+            .find(lo, hi, |k| {
+                box_near(p, &others.bounds(k), limit2)
+                    && point_triangle_distance_squared(p, tris[k]) <= limit2
+            })
+            .is_some()
+    };
+    if depth == MAX_DEPTH || !piece.iter().all(|&p| reached(p)) {
+        return false;
+    }
+    let mid = |a: [f64; 3], b: [f64; 3]| core::array::from_fn(|d| 0.5 * (a[d] + b[d]));
+    let [a, b, c] = piece;
+    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+    [[ab, bc, ca], [ca, bc, c], [ab, b, bc], [a, ab, ca]]
+        .into_iter()
+        .all(|q| covered(q, depth + 1, others, limit, last))
 }
 
-/// Whether `p` lies within `√limit2` of triangle `o`; its bounding box rules most triangles out
-/// at a fraction of the exact distance's cost.
+/// Whether `p` lies within `√limit2` of bounding box `b`: a triangle inside it can be that near
+/// only then, and the test rules most triangles out at a fraction of the exact distance's cost.
 #[inline]
-fn near(p: [f64; 3], o: &[[f64; 3]; 3], limit2: f64) -> bool {
+fn box_near(p: [f64; 3], [lo, hi]: &[[f64; 3]; 2], limit2: f64) -> bool {
     let mut outside2 = 0.0;
     for d in 0..3 {
-        let lo = o[0][d].min(o[1][d]).min(o[2][d]);
-        let hi = o[0][d].max(o[1][d]).max(o[2][d]);
-        let gap = (lo - p[d]).max(p[d] - hi).max(0.0);
+        let gap = (lo[d] - p[d]).max(p[d] - hi[d]).max(0.0);
         outside2 += gap * gap;
     }
-    outside2 <= limit2 && point_triangle_distance_squared(p, *o) <= limit2
+    outside2 <= limit2
 }
 
 /// The shape of a triangle, from 0 (degenerate) to 1 (equilateral): `48 · area² / (Σ side²)²`.

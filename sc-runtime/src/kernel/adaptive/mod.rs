@@ -27,18 +27,19 @@ pub(crate) const MAX_POLYGON: usize = MAX_CORNERS * (1 + MAX_MIDS);
 /// The most triangles a box emits: a polygon of `MAX_POLYGON` vertices, triangulated.
 pub(crate) const MAX_TRIANGLES: usize = MAX_POLYGON - 2;
 
-/// An occupied unit edge's crossing (SPEC §1): where along the edge, and which way.
+/// An occupied unit edge's crossing (SPEC §1): where along the edge. Which way it crosses is
+/// read from the samples ([`BoxSource::filled`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Crossing {
     /// Distance of the vertex from the edge's lower end, in grid steps (SPEC §1's clamp keeps it
     /// inside `(0, 1)`).
     pub t: f64,
-    /// Whether the lower end is the filled one: the surface's normal then points up the axis.
-    pub lower_filled: bool,
 }
 
 /// What a box reads of the volume, in the whole grid's sample indices.
 pub(crate) trait BoxSource {
+    /// Whether the sample at `p` is filled (SPEC §1).
+    fn filled(&self, p: [usize; 3]) -> bool;
     /// The crossing of the unit edge from `lower` along `axis`, if it is occupied.
     fn crossing(&self, lower: [usize; 3], axis: usize) -> Option<Crossing>;
     /// Calls `f` with each Steps 1–3 triangle of unit cube `cube`, its corners in grid steps,
@@ -89,6 +90,8 @@ impl Vertex {
 pub(crate) struct Patch<'a> {
     /// The triangles, cube by cube.
     pub tris: &'a [[[f64; 3]; 3]],
+    /// Each triangle's bounding box, lower and upper corner ([`checks::bounds`]).
+    pub boxes: &'a [[[f64; 3]; 2]],
     /// Cube `c`'s triangles are `tris[starts[c]..starts[c + 1]]`, `c = x + side · (y + side · z)`
     /// in cubes from the box's corner.
     pub starts: &'a [u32],

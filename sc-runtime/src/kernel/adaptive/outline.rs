@@ -88,16 +88,20 @@ pub(crate) fn outline(src: &impl BoxSource, corner: [usize; 3], side: usize) -> 
     for axis in 0..3 {
         for u in 0..=side {
             for v in 0..=side {
+                // Each sample once: an edge is occupied where the filled state changes.
                 let mut count = 0;
+                let mut below = src.filled(on_line(corner, axis, [u, v], 0));
                 for k in 0..side {
-                    if let Some(c) = src.crossing(on_line(corner, axis, [u, v], k), axis) {
+                    let above = src.filled(on_line(corner, axis, [u, v], k + 1));
+                    if below != above {
                         count += 1;
                         match dirs[axis] {
-                            None => dirs[axis] = Some(c.lower_filled),
-                            Some(d) if d != c.lower_filled => return Shape::Complex,
+                            None => dirs[axis] = Some(below),
+                            Some(d) if d != below => return Shape::Complex,
                             Some(_) => {}
                         }
                     }
+                    below = above;
                 }
                 if count > 1 {
                     return Shape::Complex;

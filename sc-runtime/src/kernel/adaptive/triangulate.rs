@@ -80,64 +80,134 @@ fn refined_boundary(
         let (x, y) = (usize::from(tri[s]), usize::from(tri[(s + 1) % 3]));
         out[m] = outline.corners[x];
         m += 1;
-        if (x + 1) % outline.n == y && refined >> x & 1 == 1 {
-            for &w in &outline.mids[x][..usize::from(outline.mid_count[x])] {
-                out[m] = w;
-                m += 1;
-            }
+        for &w in side_mids(outline, refined, x, y) {
+            out[m] = w;
+            m += 1;
         }
     }
     (out, m)
 }
 
-/// The best fan of a small polygon whose triangles all face up and none lies in a face, with
-/// its worst triangle's quality.
-fn best_fan(
-    outline: &Outline,
-    q: &[Vertex],
-) -> Option<([[Vertex; 3]; 1 + 3 * MAX_MIDS], usize, f64)> {
+/// The kept midline vertices on side `x → y` of a coarse triangle: those of arc `x`, if the
+/// side is that arc and the variant keeps them.
+fn side_mids(outline: &Outline, refined: u8, x: usize, y: usize) -> &[Vertex] {
+    if (x + 1) % outline.n == y && refined >> x & 1 == 1 {
+        &outline.mids[x][..usize::from(outline.mid_count[x])]
+    } else {
+        &[]
+    }
+}
+
+/// How many triangles coarse triangle `tri`'s fan has: one, and one per kept midline vertex on
+/// its sides ([`refined_boundary`]'s length less two).
+fn fan_size(outline: &Outline, refined: u8, tri: [u8; 3]) -> usize {
+    (0..3)
+        .map(|s| {
+            let (x, y) = (usize::from(tri[s]), usize::from(tri[(s + 1) % 3]));
+            side_mids(outline, refined, x, y).len()
+        })
+        .sum::<usize>()
+        + 1
+}
+
+/// The best fan of a small polygon whose triangles all face up and none lies in a face: its
+/// apex and its worst triangle's quality (the first apex on a tie).
+fn best_fan(outline: &Outline, q: &[Vertex]) -> Option<(usize, f64)> {
     let m = q.len();
-    let mut best: Option<([[Vertex; 3]; 1 + 3 * MAX_MIDS], usize, f64)> = None;
+    let mut best: Option<(usize, f64)> = None;
     let apexes = if m == 3 { 1 } else { m };
     for apex in 0..apexes {
-        let mut fan = [[Vertex::default(); 3]; 1 + 3 * MAX_MIDS];
         let mut worst = f64::INFINITY;
         let mut ok = true;
         for s in 0..m - 2 {
-            let t = [q[apex], q[(apex + 1 + s) % m], q[(apex + 2 + s) % m]];
+            let t = fan_triangle(q, apex, s);
             if in_wall(&t) || !faces_up(&t, outline) {
                 ok = false;
                 break;
             }
             worst = worst.min(quality(&t));
-            fan[s] = t;
         }
-        if ok && best.as_ref().is_none_or(|b| worst > b.2) {
-            best = Some((fan, m - 2, worst));
+        if ok && best.is_none_or(|b| worst > b.1) {
+            best = Some((apex, worst));
         }
     }
     best
 }
 
-/// The refined triangles of coarse triangulation `coarse`, with its worst triangle's quality,
-/// if every small polygon has a fan that faces up with no triangle in a face.
-fn refine(outline: &Outline, refined: u8, coarse: &[[u8; 3]]) -> Option<(Triangulation, f64)> {
-    let mut out = Triangulation {
-        tris: [[Vertex::default(); 3]; MAX_TRIANGLES],
-        n: 0,
-    };
-    let mut worst = f64::INFINITY;
-    for &tri in coarse {
-        let (q, len) = refined_boundary(outline, refined, tri);
-        let (fan, count, w) = best_fan(outline, &q[..len])?;
-        worst = worst.min(w);
-        for &t in &fan[..count] {
-            if !out.push(t) {
-                return None;
-            }
+/// Triangle `s` of the fan of small polygon `q` from vertex `apex`.
+#[inline]
+fn fan_triangle(q: &[Vertex], apex: usize, s: usize) -> [Vertex; 3] {
+    let m = q.len();
+    [q[apex], q[(apex + 1 + s) % m], q[(apex + 2 + s) % m]]
+}
+
+/// Corner triangles of a polygon of at most six corners: `C(6, 3)`.
+const CORNER_TRIANGLES: usize = 20;
+
+/// Corner triangle `x < y < z`'s number, in `0 .. CORNER_TRIANGLES`.
+#[inline]
+fn corner_slot([x, y, z]: [u8; 3]) -> usize {
+    let (x, y, z) = (usize::from(x), usize::from(y), usize::from(z));
+    z * (z - 1) * (z - 2) / 6 + y * (y - 1) / 2 + x
+}
+
+/// The best fans of a variant's corner triangles, each found once: the 1 to 14 coarse
+/// triangulations share 1 to 20 corner triangles.
+struct Fans<'o> {
+    outline: &'o Outline,
+    refined: u8,
+    /// Per corner triangle ([`corner_slot`]): not yet asked, or its best fan if it has one.
+    found: [Option<Option<(u8, f64)>>; CORNER_TRIANGLES],
+}
+
+impl<'o> Fans<'o> {
+    fn new(outline: &'o Outline, refined: u8) -> Self {
+        Fans {
+            outline,
+            refined,
+            found: [None; CORNER_TRIANGLES],
         }
     }
-    Some((out, worst))
+
+    /// Corner triangle `tri`'s best fan ([`best_fan`]): its apex and its worst quality.
+    fn get(&mut self, tri: [u8; 3]) -> Option<(u8, f64)> {
+        let (outline, refined) = (self.outline, self.refined);
+        *self.found[corner_slot(tri)].get_or_insert_with(|| {
+            let (q, len) = refined_boundary(outline, refined, tri);
+            best_fan(outline, &q[..len]).map(|(apex, worst)| (apex as u8, worst))
+        })
+    }
+
+    /// The worst triangle's quality of coarse triangulation `coarse` refined, if every small
+    /// polygon has a fan that faces up with no triangle in a face, and the fans fit.
+    fn rank(&mut self, coarse: &[[u8; 3]]) -> Option<f64> {
+        let mut worst = f64::INFINITY;
+        let mut count = 0;
+        for &tri in coarse {
+            let (_, w) = self.get(tri)?;
+            worst = worst.min(w);
+            count += fan_size(self.outline, self.refined, tri);
+        }
+        (count <= MAX_TRIANGLES).then_some(worst)
+    }
+
+    /// The refined triangles of coarse triangulation `coarse`, if [`Fans::rank`] ranks it.
+    fn refine(&mut self, coarse: &[[u8; 3]]) -> Option<Triangulation> {
+        let mut out = Triangulation {
+            tris: [[Vertex::default(); 3]; MAX_TRIANGLES],
+            n: 0,
+        };
+        for &tri in coarse {
+            let (apex, _) = self.get(tri)?;
+            let (q, len) = refined_boundary(self.outline, self.refined, tri);
+            for s in 0..len - 2 {
+                if !out.push(fan_triangle(&q[..len], usize::from(apex), s)) {
+                    return None;
+                }
+            }
+        }
+        Some(out)
+    }
 }
 
 /// The most coarse triangulations of a corner polygon: 14, of a hexagon.
@@ -218,12 +288,16 @@ pub(crate) fn triangulate(
     if !simple_projection(&polygon[..m], outline.axis) {
         return None;
     }
-    // (quality, enumeration index) of each candidate whose fans exist.
+    // Every coarse triangulation, and (quality, enumeration index) of each whose fans exist.
+    let mut coarses = [([[0u8; 3]; MAX_CORNERS - 2], 0usize); MAX_COARSE];
     let mut ranked = [(0.0, 0u8); MAX_COARSE];
-    let (mut n, mut index) = (0, 0u8);
+    let mut fans = Fans::new(outline, refined);
+    let (mut n, mut index) = (0, 0usize);
     each_coarse(outline.n, &mut |coarse| {
-        if let Some((_, worst)) = refine(outline, refined, coarse) {
-            ranked[n] = (worst, index);
+        coarses[index].0[..coarse.len()].copy_from_slice(coarse);
+        coarses[index].1 = coarse.len();
+        if let Some(worst) = fans.rank(coarse) {
+            ranked[n] = (worst, index as u8);
             n += 1;
         }
         index += 1;
@@ -238,15 +312,10 @@ pub(crate) fn triangulate(
         }
     }
     for &(_, wanted) in ranked.iter() {
-        let mut found = None;
-        let mut index = 0u8;
-        each_coarse(outline.n, &mut |coarse| {
-            if index == wanted {
-                found = refine(outline, refined, coarse).map(|(t, _)| t);
-            }
-            index += 1;
-        });
-        let Some(t) = found else { continue };
+        let (coarse, len) = &coarses[usize::from(wanted)];
+        let Some(t) = fans.refine(&coarse[..*len]) else {
+            continue;
+        };
         if passes(src, outline, refined, &t, patch, tolerance, memo) {
             return Some(t);
         }
