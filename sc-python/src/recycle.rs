@@ -5,7 +5,9 @@
 //! glibc for every call and unmapped on free, and the kernel zeroes each page again when the next
 //! call first writes it, a sixth of a large mesh's call (docs/speed-log.md has the figures). So
 //! blocks of [`LARGE`] bytes and more that are freed here wait in a small cache, up to [`CAP`]
-//! bytes, and the next allocation they fit takes one instead of asking for fresh pages.
+//! bytes, and the next allocation they fit takes one instead of asking for fresh pages; so does a
+//! vector that grows into one (a label atlas's arrays grow as the sweep goes), with its contents
+//! copied.
 //! [`release`] (`skelclimb.release_memory()`) gives them back at once.
 //!
 //! Every block comes from C's `malloc`, whose `free` and `realloc` need no size: a cached block
@@ -77,6 +79,22 @@ unsafe impl GlobalAlloc for Recycling {
         if layout.align() > MALLOC_ALIGN {
             // SAFETY: the caller's block and layout, passed on.
             return unsafe { System.realloc(ptr, layout, new_size) };
+        }
+        // A vector growing into a large block takes a cached one if one fits: copying what it
+        // holds costs less than the fresh pages `realloc` would map, which the kernel zeroes as
+        // the vector first writes them.
+        if new_size >= LARGE
+            && new_size > layout.size()
+            && let Some(block) = take(new_size)
+        {
+            // SAFETY: `ptr` holds `layout.size()` bytes, the cached block at least `new_size`,
+            // which is more, and they are different blocks; the old one is then freed once, with
+            // the layout it was allocated with.
+            unsafe {
+                core::ptr::copy_nonoverlapping(ptr, block, layout.size());
+                self.dealloc(ptr, layout);
+            }
+            return block;
         }
         // SAFETY: the block came from `malloc` or `calloc`; `realloc` knows its true size.
         unsafe { libc::realloc(ptr.cast(), new_size).cast() }
