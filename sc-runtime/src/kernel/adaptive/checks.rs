@@ -505,21 +505,23 @@ const MAX_DEPTH: usize = 10;
 /// though it may be within: the box stays unit cubes, which costs triangles only). The test is
 /// therefore exact where it accepts, with no sampling slack.
 pub(crate) fn within(t: [[f64; 3]; 3], others: &(impl Nearby + ?Sized), limit: f64) -> bool {
-    let tris = others.tris();
-    if limit.is_nan() || limit <= 0.0 || tris.is_empty() {
-        return false;
-    }
-    covered(t, 0, others, limit, &mut 0)
+    within_from(t, others, limit, &mut 0)
 }
 
-/// [`within`] against a few triangles, trying `others[*last]` first and leaving there the
-/// last one that covered a piece. Their `find` tries every triangle, so a piece is covered
-/// iff some triangle covers it, whichever is tried first: the answer is [`within`]'s.
-fn within_from(t: [[f64; 3]; 3], others: &Boxed<'_>, limit: f64, last: &mut usize) -> bool {
-    if limit.is_nan() || limit <= 0.0 || others.tris.is_empty() {
+/// [`within`], trying `others[*last]` first and leaving there the last one that covered a
+/// piece. A piece is covered iff some triangle covers it, whichever is tried first: the answer
+/// is [`within`]'s.
+fn within_from(
+    t: [[f64; 3]; 3],
+    others: &(impl Nearby + ?Sized),
+    limit: f64,
+    last: &mut usize,
+) -> bool {
+    let n = others.tris().len();
+    if limit.is_nan() || limit <= 0.0 || n == 0 {
         return false;
     }
-    if *last >= others.tris.len() {
+    if *last >= n {
         *last = 0;
     }
     covered(t, 0, others, limit, last)
