@@ -121,6 +121,8 @@ pub fn finish_label_blocks<'py>(
             background: label::<L>(&background)?,
             mode,
             normals,
+            // As each block's task: one thread, the scheduler shares out the rest.
+            threads: 1,
             selection,
         };
         respond(py, atlas, reply)

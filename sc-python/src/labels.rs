@@ -125,6 +125,7 @@ where
         background,
         mode: mode_name,
         normals,
+        threads,
         selection,
     };
     respond(py, atlas, reply)
@@ -150,6 +151,8 @@ pub struct Reply<'a, 'py, L> {
     pub background: L,
     pub mode: &'a str,
     pub normals: bool,
+    /// Threads the meshes are cut on (0 for all).
+    pub threads: usize,
     pub selection: Option<Vec<Bound<'py, PyAny>>>,
 }
 
@@ -169,7 +172,7 @@ where
         py.detach(|| place(world, &mut atlas));
     }
     let chosen = choose(&atlas.labels(background), background, reply.selection)?;
-    let meshes = py.detach(|| atlas.meshes(&chosen, normals));
+    let meshes = py.detach(|| atlas.meshes(&chosen, normals, reply.threads));
 
     let stats = PyDict::new(py);
     stats.set_item("dims", reply.dims)?;

@@ -1,7 +1,8 @@
-//! Times one label volume's extraction on one thread, for profiling the label sweep: the best
-//! of `RUNS` runs of `extract_labels` (embedded, padded) and, apart, of cutting the atlas into
-//! one mesh per label. Prints a checksum of the atlas (positions, triangles, pairs), so that a
-//! change to the sweep can be checked to leave the atlas bit-identical.
+//! Times one label volume's extraction for profiling the label sweep, on one thread (or on
+//! `THREADS` from the environment, 0 for all): the best of `RUNS` runs of `extract_labels`
+//! (embedded, padded) and, apart, of cutting the atlas into one mesh per label. Prints a
+//! checksum of the atlas (positions, triangles, pairs), so that a change to the sweep can be
+//! checked to leave the atlas bit-identical.
 //! Under `valgrind --tool=callgrind` pass `RUNS` = 1.
 //!
 //! ```sh
@@ -49,7 +50,7 @@ fn time<L: Label + Into<u64> + TryFrom<u64>>(
     let volume = Volume::new(data, dims)?;
     let params = LabelParams {
         background: L::try_from(background).map_err(|_| "background out of range")?,
-        threads: 1,
+        threads: std::env::var("THREADS").map_or(Ok(1), |t| t.parse())?,
         ..LabelParams::default()
     };
     let (mut sweep, mut cut) = (Duration::MAX, Duration::MAX);
@@ -59,7 +60,7 @@ fn time<L: Label + Into<u64> + TryFrom<u64>>(
         let atlas = extract_labels(volume, &params)?;
         let t1 = Instant::now();
         let labels = atlas.labels(params.background);
-        let meshes = atlas.meshes(&labels, false);
+        let meshes = atlas.meshes(&labels, false, params.threads);
         let t2 = Instant::now();
         sweep = sweep.min(t1 - t0);
         cut = cut.min(t2 - t1);

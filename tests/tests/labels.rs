@@ -419,7 +419,12 @@ fn check_volume(vol: &Labels, mode: Mode, what: &str) {
         &crossings[..crossings.len().min(4)]
     );
     let labels = atlas.labels(0);
-    let meshes = atlas.meshes(&labels, false);
+    let meshes = atlas.meshes(&labels, false, 1);
+    assert_eq!(
+        atlas.meshes(&labels, true, 3),
+        atlas.meshes(&labels, true, 1),
+        "{what}: threads"
+    );
     let present: BTreeSet<u16> = vol.data.iter().copied().filter(|&l| l != 0).collect();
     assert_eq!(
         labels.iter().copied().collect::<BTreeSet<_>>(),
@@ -570,7 +575,12 @@ fn any_thread_count_gives_the_same_atlas() {
         .unwrap()
     };
     let one = atlas(1);
-    assert!(one.stats.merged > 0 && one.triangles.len() > 1000);
+    // Large enough that Step 4's compaction runs in several chunks of 1,024 on threads.
+    assert!(
+        one.stats.merged > 0 && one.positions.len() > 2048,
+        "{:?}",
+        one.stats
+    );
     for threads in [2, 3, 0] {
         assert_eq!(atlas(threads), one, "{threads} threads");
     }
@@ -701,7 +711,7 @@ fn check_smoothed(vol: &Labels, what: &str) {
         crossings.len()
     );
     let labels = atlas.labels(0);
-    for (label, mesh) in atlas.meshes(&labels, false) {
+    for (label, mesh) in atlas.meshes(&labels, false, 0) {
         let problems = manifold_problems(mesh.positions.len(), &mesh.triangles, 5);
         assert!(problems.is_empty(), "{what} label {label}: {problems:?}");
         for z in 0..vol.dims[2] {

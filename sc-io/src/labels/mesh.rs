@@ -216,7 +216,7 @@ where
 {
     let chosen = chosen(&atlas.labels(background), request)?;
     let meshes = atlas
-        .meshes(&chosen, request.normals)
+        .meshes(&chosen, request.normals, request.threads)
         .into_iter()
         .filter_map(|(l, mesh)| Some((id(l)?, mesh)))
         .collect();

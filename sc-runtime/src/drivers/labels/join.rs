@@ -25,9 +25,15 @@ pub(super) fn join<L: Label>(
         top,
         ..
     } = first;
+    let rest: Vec<Piece<L>> = pieces.collect();
+    let more = |f: &dyn Fn(&Piece<L>) -> usize| rest.iter().map(f).sum::<usize>();
+    atlas.positions.reserve(more(&|p| p.atlas.positions.len()));
+    atlas.triangles.reserve(more(&|p| p.atlas.triangles.len()));
+    atlas.pairs.reserve(more(&|p| p.atlas.triangles.len()));
+    edges.reserve(more(&|p| p.edges.len()));
     // The previous piece's top plane, in the joined numbering (plus one, 0 for none).
     let mut shared = top;
-    for piece in pieces {
+    for piece in rest {
         let mut number = vec![u32::MAX; piece.atlas.positions.len()];
         for (mine, theirs) in piece.bottom.iter().zip(&shared) {
             for (&m, &t) in mine.iter().zip(theirs) {
@@ -51,19 +57,15 @@ pub(super) fn join<L: Label>(
         }
         pinned.extend(piece.pinned.iter().map(|&v| number[v as usize]));
         let first_triangle = atlas.triangles.len() as u32;
-        atlas.triangles.extend(
-            piece
-                .atlas
-                .triangles
-                .iter()
-                .map(|t| t.map(|v| number[v as usize])),
-        );
+        extend_mapped(&mut atlas.triangles, &piece.atlas.triangles, |t| {
+            t.map(|v| number[v as usize])
+        });
         atlas.pairs.extend_from_slice(&piece.atlas.pairs);
-        ears.extend(piece.ears.into_iter().map(|ear| Ear {
+        extend_mapped(&mut ears, &piece.ears, |ear| Ear {
             vertex: number[ear.vertex as usize],
             triangle: first_triangle + ear.triangle,
-            ..ear
-        }));
+            ..*ear
+        });
         shared = piece.top.map(|plane| {
             plane
                 .iter()
@@ -78,4 +80,17 @@ pub(super) fn join<L: Label>(
         });
     }
     (atlas, ears, edges, pinned)
+}
+
+/// `to` extended by `f` of each of `from`, on the current pool: the copies are most of a join.
+#[cfg(feature = "std")]
+fn extend_mapped<S: Sync, T: Send>(to: &mut Vec<T>, from: &[S], f: impl Fn(&S) -> T + Sync + Send) {
+    use rayon::prelude::*;
+    to.par_extend(from.par_iter().map(f));
+}
+
+/// `to` extended by `f` of each of `from`.
+#[cfg(not(feature = "std"))]
+fn extend_mapped<S, T>(to: &mut Vec<T>, from: &[S], f: impl Fn(&S) -> T) {
+    to.extend(from.iter().map(f));
 }

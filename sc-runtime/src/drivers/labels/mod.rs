@@ -115,33 +115,16 @@ pub struct Atlas<L> {
 
 /// Meshes the regions of a label volume.
 ///
-/// The grid is swept in pieces of a fixed number of layers, on [`LabelParams::threads`]
-/// threads, and the pieces are joined in order, so the atlas is the same for any number of
-/// threads.
+/// The grid is swept in pieces of layers, one per thread of [`LabelParams::threads`], and the
+/// pieces are joined in order, so the atlas is the same for any number of threads.
 pub fn extract_labels<L: Label>(
     volume: Volume<'_, L>,
     params: &LabelParams<L>,
 ) -> Result<Atlas<L>, Error> {
     check(params)?;
     let grid = Padded::new(volume, params);
-    let layers = grid.n[2].saturating_sub(1);
-    // One thread sweeps the grid as one piece: pieces only share the work out, and joining
-    // them copies the whole output and sweeps each piece's constructions anew. The atlas is the
-    // same for any piece size.
-    let piece = match params.threads == 1 || cfg!(not(feature = "std")) {
-        true => layers.max(1),
-        false => PIECE_LAYERS,
-    };
-    let ranges: Vec<Range<usize>> = if grid.n.iter().all(|&n| n >= 2) {
-        (0..layers)
-            .step_by(piece)
-            .map(|k| k..(k + piece).min(layers))
-            .collect()
-    } else {
-        Vec::new()
-    };
     on_threads(params.threads, || {
-        let pieces = sweep_pieces(&grid, params, ranges)?;
+        let pieces = sweep_pieces(&grid, params, pieces(&grid, workers(params.threads)))?;
         let (mut atlas, ears, mut edges, mut pinned) = join::join(pieces);
         atlas.stats.v13 = atlas.positions.len() as u64;
         atlas.stats.t13 = atlas.triangles.len() as u64;
@@ -155,6 +138,67 @@ pub fn extract_labels<L: Label>(
         atlas.stats.triangles = atlas.triangles.len() as u64;
         Ok(atlas)
     })?
+}
+
+/// The layers of each piece of the sweep: one piece per worker, since joining copies every
+/// piece but the first and each piece sweeps its first plane anew, cut so that the pieces hold
+/// about as much of the surface (label changes) as of the grid's cubes, each half of the
+/// weight. The atlas is the same for any split.
+fn pieces<L: Label>(grid: &Padded<'_, L>, workers: usize) -> Vec<Range<usize>> {
+    if grid.n.iter().any(|&n| n < 2) {
+        return Vec::new();
+    }
+    let layers = grid.n[2] - 1;
+    if workers <= 1 || layers < 2 {
+        return core::iter::once(0..layers).collect();
+    }
+    let changes = layer_changes(grid, layers);
+    let total_changes = changes.iter().sum::<usize>().max(1) as f64;
+    // Each layer's share of the work, from 0 to 1 over the grid.
+    let weight = |z: usize| 0.5 / layers as f64 + 0.5 * changes[z] as f64 / total_changes;
+    let mut ranges = Vec::with_capacity(workers);
+    let (mut start, mut done) = (0, 0.0);
+    for z in 0..layers {
+        done += weight(z);
+        let target = (ranges.len() + 1) as f64 / workers as f64;
+        if done >= target && ranges.len() + 1 < workers && z + 1 < layers {
+            ranges.push(start..z + 1);
+            start = z + 1;
+        }
+    }
+    ranges.push(start..layers);
+    ranges
+}
+
+/// [`Padded::changes`] of each layer's lower plane, on the current pool.
+#[cfg(feature = "std")]
+fn layer_changes<L: Label>(grid: &Padded<'_, L>, layers: usize) -> Vec<usize> {
+    use rayon::prelude::*;
+    (0..layers)
+        .into_par_iter()
+        .map(|z| grid.changes(z))
+        .collect()
+}
+
+/// [`Padded::changes`] of each layer's lower plane.
+#[cfg(not(feature = "std"))]
+fn layer_changes<L: Label>(grid: &Padded<'_, L>, layers: usize) -> Vec<usize> {
+    (0..layers).map(|z| grid.changes(z)).collect()
+}
+
+/// The threads work is shared over, called where [`on_threads`] runs its job.
+#[cfg(feature = "std")]
+fn workers(threads: usize) -> usize {
+    match threads {
+        1 => 1,
+        _ => rayon::current_num_threads(),
+    }
+}
+
+/// One thread: the caller's.
+#[cfg(not(feature = "std"))]
+fn workers(_threads: usize) -> usize {
+    1
 }
 
 /// Refuses what no label extraction runs: a smoothing width out of range, adaptive mode.
@@ -209,10 +253,6 @@ fn renumber(edges: &mut Vec<sweep::Edge>, pinned: &mut Vec<u32>, kept: &[u32]) {
         *v = kept[*v as usize];
     }
 }
-
-/// Layers per piece of the sweep: enough that joining costs little, few enough that two
-/// threads share a small volume evenly.
-const PIECE_LAYERS: usize = 16;
 
 /// The pieces of `ranges`, in order, on the pool [`on_threads`] chose.
 #[cfg(feature = "std")]
@@ -301,37 +341,73 @@ impl<L: Label> Atlas<L> {
     /// One closed mesh per label of `labels` (ascending, as [`Atlas::labels`] gives them), each
     /// wound outward: the atlas's triangles with the label first, and those with it second,
     /// flipped. With `normals`, each vertex gets the normalised sum of its triangles' area
-    /// normals in that mesh.
-    pub fn meshes(&self, labels: &[L], normals: bool) -> Vec<(L, Mesh)> {
-        // Counted first, so that each label's triangles are one allocation, not a doubling
-        // series of copies.
+    /// normals in that mesh. Cut on `threads` threads (0 for all, 1 for the calling thread
+    /// alone; the meshes do not depend on it); where a pool cannot be started, on this thread.
+    pub fn meshes(&self, labels: &[L], normals: bool, threads: usize) -> Vec<(L, Mesh)> {
         let find = Find::new(labels, self.triangles.len());
-        let mut counts = vec![0usize; labels.len()];
-        self.each_side(&find, |i, _, _| counts[i] += 1);
-        let mut buckets: Vec<Vec<[u32; 3]>> =
-            counts.iter().map(|&n| Vec::with_capacity(n)).collect();
-        self.each_side(&find, |i, t, first| {
-            buckets[i].push(if first { *t } else { [t[0], t[2], t[1]] });
-        });
+        #[cfg(not(feature = "std"))]
+        let _ = threads;
+        #[cfg(feature = "std")]
+        if threads != 1
+            && let Ok(meshes) = on_threads(threads, || self.meshes_on_pool(&find, normals))
+        {
+            return meshes;
+        }
         let mut local = vec![u32::MAX; self.positions.len()];
         labels
             .iter()
-            .zip(buckets)
+            .zip(self.sides(&find, 0..self.triangles.len()))
             .map(|(&label, triangles)| (label, self.mesh_of(triangles, &mut local, normals)))
             .collect()
     }
 
-    /// Calls `side(i, triangle, first)` for each triangle and each of its labels that is
-    /// `labels[i]`: `first` if it is the label the triangle faces away from.
-    fn each_side(&self, find: &Find<'_, L>, mut side: impl FnMut(usize, &[u32; 3], bool)) {
-        for (t, pair) in self.triangles.iter().zip(&self.pairs) {
-            if let Some(i) = find.get(pair[0]) {
-                side(i, t, true);
-            }
-            if let Some(i) = find.get(pair[1]) {
-                side(i, t, false);
+    /// [`Atlas::meshes`] on the current pool: the triangles in one run per thread, each split
+    /// by label, then the labels' meshes, each worker with its own renumbering array.
+    #[cfg(feature = "std")]
+    fn meshes_on_pool(&self, find: &Find<'_, L>, normals: bool) -> Vec<(L, Mesh)> {
+        use rayon::prelude::*;
+        let n = self.triangles.len();
+        let run = n.div_ceil(rayon::current_num_threads()).max(1);
+        let runs: Vec<Vec<Vec<[u32; 3]>>> = (0..n.div_ceil(run))
+            .into_par_iter()
+            .map(|k| self.sides(find, k * run..n.min((k + 1) * run)))
+            .collect();
+        let mut per_label: Vec<Vec<Vec<[u32; 3]>>> =
+            find.labels.iter().map(|_| Vec::new()).collect();
+        for sides in runs {
+            for (parts, part) in per_label.iter_mut().zip(sides) {
+                parts.push(part);
             }
         }
+        find.labels
+            .par_iter()
+            .zip(per_label)
+            .map_init(
+                || vec![u32::MAX; self.positions.len()],
+                |local, (&label, mut parts)| {
+                    let triangles = match parts.len() {
+                        1 => parts.pop().unwrap_or_default(),
+                        _ => parts.concat(),
+                    };
+                    (label, self.mesh_of(triangles, local, normals))
+                },
+            )
+            .collect()
+    }
+
+    /// Per label of `find`, the triangles of `range` it bounds, wound outward from it.
+    fn sides(&self, find: &Find<'_, L>, range: Range<usize>) -> Vec<Vec<[u32; 3]>> {
+        // Counted first, so that each label's triangles are one allocation, not a doubling
+        // series of copies.
+        let (triangles, pairs) = (&self.triangles[range.clone()], &self.pairs[range]);
+        let mut counts = vec![0usize; find.labels.len()];
+        each_side(triangles, pairs, find, |i, _, _| counts[i] += 1);
+        let mut buckets: Vec<Vec<[u32; 3]>> =
+            counts.iter().map(|&n| Vec::with_capacity(n)).collect();
+        each_side(triangles, pairs, find, |i, t, first| {
+            buckets[i].push(if first { *t } else { [t[0], t[2], t[1]] });
+        });
+        buckets
     }
 
     /// The mesh of `triangles` (atlas indices), renumbered in order of first use; `local` is
@@ -370,6 +446,24 @@ impl<L: Label> Atlas<L> {
             values: Vec::new(),
             triangles,
             stats,
+        }
+    }
+}
+
+/// Calls `side(i, triangle, first)` for each triangle and each of its labels that is
+/// `find`'s `i`-th: `first` if it is the label the triangle faces away from.
+fn each_side<L: Label>(
+    triangles: &[[u32; 3]],
+    pairs: &[[L; 2]],
+    find: &Find<'_, L>,
+    mut side: impl FnMut(usize, &[u32; 3], bool),
+) {
+    for (t, pair) in triangles.iter().zip(pairs) {
+        if let Some(i) = find.get(pair[0]) {
+            side(i, t, true);
+        }
+        if let Some(i) = find.get(pair[1]) {
+            side(i, t, false);
         }
     }
 }

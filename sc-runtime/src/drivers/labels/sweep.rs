@@ -15,6 +15,7 @@ use crate::{Error, Mode, Volume};
 const NONE: u32 = u32::MAX;
 
 /// A binary cube's ear on a grey edge: what Step 4 needs to merge the four around the edge.
+#[derive(Clone, Copy)]
 pub(super) struct Ear<L> {
     pub vertex: u32,
     pub triangle: u32,
@@ -133,6 +134,43 @@ impl<'a, L: Label> Padded<'a, L> {
             row[x0 - xs.start..x1 - xs.start].copy_from_slice(&src[from(x0)..from(x1)]);
             row[x1 - xs.start..].fill(self.background);
         }
+    }
+
+    /// About how much surface layer `z` of the padded grid holds: how often the label changes
+    /// from a sample of plane `z` to the next along each axis, counted on every fourth row,
+    /// which is plenty to share the work out by.
+    pub fn changes(&self, z: usize) -> usize {
+        let start = self.pad + self.at[2];
+        if z < start || z >= start + self.dims[2] {
+            return 0;
+        }
+        let [dx, dy, dz] = self.dims;
+        let row = |y: usize, z: usize| &self.data[dx * (y + dy * z)..][..dx];
+        // Exact slices of one length and a flag sum: vector compares.
+        let differ = |a: &[L], b: &[L]| -> usize {
+            let n = a.len().min(b.len());
+            let (a, b) = (&a[..n], &b[..n]);
+            (0..n).fold(0u32, |c, i| c + u32::from(a[i] != b[i])) as usize
+        };
+        let z = z - start;
+        (0..dy)
+            .step_by(4)
+            .map(|y| {
+                let here = row(y, z);
+                let along_x = differ(here, &here[1..]);
+                let along_y = if y + 1 < dy {
+                    differ(here, row(y + 1, z))
+                } else {
+                    0
+                };
+                let along_z = if z + 1 < dz {
+                    differ(here, row(y, z + 1))
+                } else {
+                    0
+                };
+                along_x + along_y + along_z
+            })
+            .sum()
     }
 
     /// `kind`, [`few_labels`] of the labels themselves, as it is of their keys: the keys order
