@@ -622,6 +622,53 @@ fn another_background_is_a_relabelling() {
     }
 }
 
+/// Labels too large to index a table by (u64 ids, as connectomics volumes hold them) or
+/// negative ones are found by a map instead: an order-keeping relabelling gives the same atlas
+/// with its pairs relabelled, the same labels met and the same per-label meshes, on 1 and 3
+/// threads.
+#[test]
+fn large_and_negative_labels_are_a_relabelling() {
+    let vol = cells([13, 11, 12], 9, 3);
+    let small = vol.atlas(Mode::Embedded);
+    let labels = small.labels(0);
+    let meshes = small.meshes(&labels, true, 1);
+    fn same<L: sc_runtime::labels::Label>(
+        data: &[L],
+        vol: &Labels,
+        relabel: impl Fn(u16) -> L,
+        small: &Atlas<u16>,
+        meshes: &[(u16, sc_runtime::Mesh)],
+    ) {
+        let params = LabelParams {
+            background: relabel(0),
+            spacing: [1.0, 1.25, 0.75],
+            origin: [-2.0, 1.0, 0.5],
+            ..LabelParams::default()
+        };
+        let atlas = extract_labels(Volume::new(data, vol.dims).unwrap(), &params).unwrap();
+        assert_eq!(atlas.positions, small.positions);
+        assert_eq!(atlas.triangles, small.triangles);
+        let pairs: Vec<[L; 2]> = small.pairs.iter().map(|p| p.map(&relabel)).collect();
+        assert_eq!(atlas.pairs, pairs);
+        let labels = atlas.labels(relabel(0));
+        let expected: Vec<L> = meshes.iter().map(|&(l, _)| relabel(l)).collect();
+        assert_eq!(labels, expected);
+        for threads in [1, 3] {
+            let big = atlas.meshes(&labels, true, threads);
+            for ((l, mesh), (s, small_mesh)) in big.iter().zip(meshes) {
+                assert_eq!((*l, mesh), (relabel(*s), small_mesh), "{threads} threads");
+            }
+            assert_eq!(big.len(), meshes.len());
+        }
+    }
+    let wide = |l: u16| (u64::from(l) << 40) + 7;
+    let data: Vec<u64> = vol.data.iter().map(|&l| wide(l)).collect();
+    same(&data, &vol, wide, &small, &meshes);
+    let negative = |l: u16| i32::from(l) * 70_001 - 1_000_000;
+    let data: Vec<i32> = vol.data.iter().map(|&l| negative(l)).collect();
+    same(&data, &vol, negative, &small, &meshes);
+}
+
 /// A ball of `r` voxels' radius, digitised at the samples of a cube of side `2r + 6`.
 fn ball(r: f64) -> Labels {
     let n = (2.0 * r) as usize + 6;

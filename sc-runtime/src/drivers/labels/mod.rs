@@ -10,6 +10,8 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use hashbrown::{HashMap, HashSet};
+
 use crate::{Error, Mesh, Mode, Stats, Volume};
 
 mod blocks;
@@ -26,7 +28,9 @@ use sweep::Padded;
 pub use blocks::{AtlasBlock, block_samples, extract_block};
 
 /// A sample type that can hold labels: an integer whose values name regions.
-pub trait Label: Copy + Ord + Send + Sync + core::fmt::Debug + 'static + sealed::Sealed {
+pub trait Label:
+    Copy + Ord + core::hash::Hash + Send + Sync + core::fmt::Debug + 'static + sealed::Sealed
+{
     /// Zero, the default background.
     const ZERO: Self;
 }
@@ -308,9 +312,10 @@ impl<L: Label> Atlas<L> {
     /// The labels with a surface, ascending, without the background (`background`).
     pub fn labels(&self, background: L) -> Vec<L> {
         // Neighbouring triangles often share their pair, and labels are mostly small integers,
-        // which a table marks as met: what is left to sort is little more than the labels.
+        // which a table marks as met; larger ones (a connectomics volume's ids) go in a set.
         let mut labels: Vec<L> = Vec::new();
         let mut met: Vec<bool> = Vec::new();
+        let mut large: HashSet<L> = HashSet::new();
         let mut last = None;
         for &pair in &self.pairs {
             if last == Some(pair) {
@@ -328,12 +333,15 @@ impl<L: Label> Atlas<L> {
                             labels.push(l);
                         }
                     }
-                    None => labels.push(l),
+                    None => {
+                        if large.insert(l) {
+                            labels.push(l);
+                        }
+                    }
                 }
             }
         }
         labels.sort_unstable();
-        labels.dedup();
         labels.retain(|&l| l != background);
         labels
     }
@@ -458,23 +466,31 @@ fn each_side<L: Label>(
     find: &Find<'_, L>,
     mut side: impl FnMut(usize, &[u32; 3], bool),
 ) {
-    for (t, pair) in triangles.iter().zip(pairs) {
-        if let Some(i) = find.get(pair[0]) {
+    // Neighbouring triangles mostly share their pair: it is looked up once per run of them.
+    let mut last: Option<([L; 2], [Option<usize>; 2])> = None;
+    for (t, &pair) in triangles.iter().zip(pairs) {
+        let found = match last {
+            Some((p, found)) if p == pair => found,
+            _ => pair.map(|l| find.get(l)),
+        };
+        last = Some((pair, found));
+        if let Some(i) = found[0] {
             side(i, t, true);
         }
-        if let Some(i) = find.get(pair[1]) {
+        if let Some(i) = found[1] {
             side(i, t, false);
         }
     }
 }
 
 /// Where each label is in an ascending list of labels: by a table when the labels are small
-/// non-negative integers, as a segmentation's are, since neighbouring triangles' pairs differ
-/// too often to look up once per run; by binary search otherwise.
+/// non-negative integers, as a segmentation's are, by a hash map otherwise (binary search
+/// would cost a dozen unpredictable branches per triangle).
 struct Find<'a, L> {
     labels: &'a [L],
-    /// Per label value, its index in `labels`, `u32::MAX` for none; empty for binary search.
+    /// Per label value, its index in `labels`, `u32::MAX` for none; empty for the map.
     table: Vec<u32>,
+    map: HashMap<L, u32>,
 }
 
 impl<'a, L: Label> Find<'a, L> {
@@ -482,25 +498,35 @@ impl<'a, L: Label> Find<'a, L> {
     /// lookups' worth of memory per triangle at most.
     fn new(labels: &'a [L], size: usize) -> Self {
         let small = labels.first().and_then(|l| l.index()).is_some();
-        let table = match labels.last().and_then(|l| l.index()) {
+        let mut find = Find {
+            labels,
+            table: Vec::new(),
+            map: HashMap::new(),
+        };
+        match labels.last().and_then(|l| l.index()) {
             Some(max) if small && max < size.max(1 << 16) => {
-                let mut table = vec![u32::MAX; max + 1];
+                find.table = vec![u32::MAX; max + 1];
                 for (i, l) in labels.iter().enumerate() {
                     if let Some(v) = l.index() {
-                        table[v] = i as u32;
+                        find.table[v] = i as u32;
                     }
                 }
-                table
             }
-            _ => Vec::new(),
-        };
-        Find { labels, table }
+            _ => {
+                find.map = labels
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &l)| (l, i as u32))
+                    .collect()
+            }
+        }
+        find
     }
 
     #[inline]
     fn get(&self, l: L) -> Option<usize> {
         if self.table.is_empty() {
-            return self.labels.binary_search(&l).ok();
+            return self.map.get(&l).map(|&i| i as usize);
         }
         let i = *self.table.get(l.index()?)?;
         (i != u32::MAX).then_some(i as usize)
