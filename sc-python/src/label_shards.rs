@@ -1,6 +1,6 @@
 //! Label shards for the Dask driver (`skelclimb.dask.labels(shards=)`): each task writes its
 //! block's share of the atlas through the writer `skelclimb extract --labels --shards` uses
-//! (`sc_io::labels::write_shard`), and `merge_label_shards` joins any label manifest into what
+//! (`sc_io::labels::write_block`), and `merge_label_shards` joins any label manifest into what
 //! `labels` returns for the whole volume.
 
 use std::fmt::Display;
@@ -13,8 +13,8 @@ use pyo3::conversion::FromPyObjectOwned;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use sc_io::labels::{LabelSettings, Selection, Stored, join_shards, write_shard};
-use sc_io::shard::{Manifest, ShardEntry, ShardSettings};
+use sc_io::labels::{LabelSettings, Selection, Stored, join_shards, write_block};
+use sc_io::shard::{Manifest, ShardSettings};
 use sc_io::space::World;
 use sc_io::volume::Dtype;
 
@@ -84,14 +84,8 @@ pub fn write_label_shard(
     let cubes = cubes.map(|(a, b)| a..b);
     with_label!(py, &pairs, "label block pairs", L => {
         let share = from_python::<L>(&share)?;
-        let entry = ShardEntry {
-            file: ShardEntry::file_name(&cubes),
-            cubes,
-            vertices: share.keys.len() as u64,
-            triangles: share.triangles.len() as u64,
-        };
-        let path = directory.join(&entry.file);
-        py.detach(|| write_shard(&path, &share, &settings))
+        let entry = py
+            .detach(|| write_block(&directory, cubes, &share, &settings))
             .map_err(errors::io)?;
         Ok(record(entry))
     })

@@ -10,6 +10,7 @@
 //! by, and what only the merge uses: the selection, whether meshes get normals, and the label
 //! table (names and colours), which the shards leave out.
 
+use std::ops::Range;
 use std::path::Path;
 
 use sc_runtime::labels::{Atlas, AtlasBlock, Label as Sample, LabelParams, extract_block};
@@ -320,13 +321,7 @@ fn write_blocks<L: Stored>(
         let at = need.clone().map(|r| r.start);
         let volume = Volume::new(&samples, need.map(|r| r.len()))?;
         let share = extract_block(volume, at, dims, cubes.clone(), params)?;
-        let entry = ShardEntry {
-            file: ShardEntry::file_name(&cubes),
-            cubes,
-            vertices: share.keys.len() as u64,
-            triangles: share.triangles.len() as u64,
-        };
-        write_shard(&dir.join(&entry.file), &share, &manifest.settings)?;
+        let entry = write_block(dir, cubes, &share, &manifest.settings)?;
         manifest.shards.push(entry);
         progress.inc(1);
     }
@@ -334,9 +329,27 @@ fn write_blocks<L: Stored>(
     Ok(manifest)
 }
 
-/// Writes `share`, swept with `settings` (of its label type), to the shard file `path`, whole
-/// or not at all: the one writer of label shards, for the command line and Python's Dask driver.
-pub fn write_shard<L: Stored>(
+/// Writes `share`, owning `cubes` and swept with `settings` (of its label type), to its shard
+/// file in `dir`, whole or not at all, and returns the manifest's entry for it: the one writer of
+/// label shards, for the command line and Python's Dask driver.
+pub fn write_block<L: Stored>(
+    dir: &Path,
+    cubes: [Range<usize>; 3],
+    share: &AtlasBlock<L>,
+    settings: &LabelSettings,
+) -> Result<ShardEntry> {
+    let entry = ShardEntry {
+        file: ShardEntry::file_name(&cubes),
+        cubes,
+        vertices: share.keys.len() as u64,
+        triangles: share.triangles.len() as u64,
+    };
+    write_shard(&dir.join(&entry.file), share, settings)?;
+    Ok(entry)
+}
+
+/// Writes `share`, swept with `settings`, to the shard file `path`, whole or not at all.
+fn write_shard<L: Stored>(
     path: &Path,
     share: &AtlasBlock<L>,
     settings: &LabelSettings,
