@@ -182,3 +182,15 @@ def test_the_cli_merges_them_into_the_files_extract_writes(tmp_path):
     subprocess.run(run + ["merge", "-q", manifest, "-o", str(tmp_path / "joined.glb")], check=True)
     whole = (tmp_path / "whole.glb").read_bytes()
     assert len(whole) > 1000 and (tmp_path / "joined.glb").read_bytes() == whole
+
+
+def test_python_merges_the_clis_label_shards(tmp_path):
+    v = volume()
+    nz, ny, nx = v.shape
+    v.tofile(tmp_path / "seg.raw")
+    assert not (v == 3).any() and (v == 2).any()  # the range 1-3 holds labels 1 and 2 only
+    subprocess.run([skelclimb_binary(), "extract", "-q", str(tmp_path / "seg.raw"), "--dims",
+                    f"{nx},{ny},{nz}", "--dtype", "u8", "--labels", "1-3,5", "--smoothing", "1",
+                    "--shards", str(tmp_path / "parts"), "--block", "5"], check=True)
+    got = skelclimb.merge_shards(tmp_path / "parts" / "manifest.json")
+    same(got, skelclimb.labels(v, labels=[1, 2, 5], smoothing=1))
