@@ -157,16 +157,17 @@ def zarr_seeds():
     group = {"zarr_format": 3, "node_type": "group",
              "attributes": {"ome": {"version": "0.5", "multiscales": multiscales}}}
     write("zarr", "ome-v3", zarr({"zarr.json": group, "0/zarr.json": ome_v3, "0/c/0/0/0": U8_CHUNK}))
-def shard_set(*args, world=None):
-    """A shard set that `skelclimb extract --demo sphere ... --shards` writes (SKELCLIMB names
-    the binary; the debug build by default), staged as the `shards` target reads it: the
-    manifest (its files renamed s0.npz, s1.npz, ...), a NUL, then each shard as a length and
-    its bytes; `members` selects the target's own zip (an even first byte) over the file as
-    it is (odd)."""
+def shard_set(*args, world=None, files=()):
+    """A shard set that `skelclimb extract ARGS --shards` writes (SKELCLIMB names the binary;
+    the debug build by default) in a scratch folder holding `files` (name, bytes), staged as
+    the `shards` target reads it: the manifest (its files renamed s0.npz, s1.npz, ...), a NUL,
+    then each shard as a length and its bytes; `members` selects the target's own zip (a first
+    byte of 0 for a scan's members, 2 for a label shard's) over the file as it is (odd)."""
     binary = os.environ.get("SKELCLIMB", str(HERE.parent / "target" / "debug" / "skelclimb"))
     with tempfile.TemporaryDirectory() as tmp:
-        subprocess.run([binary, "-q", "extract", "--demo", "sphere", *args, "--shards", tmp + "/s"],
-                       check=True)
+        for name, data in files:
+            Path(tmp, name).write_bytes(data)
+        subprocess.run([binary, "-q", "extract", *args, "--shards", "s"], check=True, cwd=tmp)
         manifest = json.loads(Path(tmp, "s", "manifest.json").read_text())
         shards = [Path(tmp, "s", e["file"]).read_bytes() for e in manifest["shards"]]
     for i, entry in enumerate(manifest["shards"]):
@@ -175,6 +176,7 @@ def shard_set(*args, world=None):
         manifest["world"] = world
     text = json.dumps(manifest, separators=(",", ":")).encode() + b"\0"
     piece = lambda b: struct.pack("<I", len(b)) + b
+    labels = manifest.get("kind") == "labels"
 
     def staged(members):
         if not members:
@@ -182,11 +184,24 @@ def shard_set(*args, world=None):
         out = b""
         for s in shards:
             with zipfile.ZipFile(io.BytesIO(s)) as z:
-                names = ["header", "keys", "positions", "normals", "triangles", "cubes"]
-                out += piece(b"\x00" + b"".join(piece(z.read(n + ".npy")) for n in names))
+                names = ["header", "keys", "positions", "pairs" if labels else "normals",
+                         "triangles", "cubes"]
+                mode = b"\x02" if labels else b"\x00"
+                out += piece(mode + b"".join(piece(z.read(n + ".npy")) for n in names))
         return text + out
 
     return staged
+
+
+def label_volume():
+    """6×6×6 u8 labels: two boxes side by side (1 and 2) and a corner of 7, in background 0."""
+    def label(x, y, z):
+        if x == y == z == 5:
+            return 7
+        if not (1 <= y < 5 and 1 <= z < 5):
+            return 0
+        return 1 if 1 <= x < 3 else 2 if 3 <= x < 5 else 0
+    return bytes(label(x, y, z) for z in range(6) for y in range(6) for x in range(6))
 
 
 def main():
@@ -229,13 +244,22 @@ def main():
     write("stl", "binary.stl", stl_binary())
     write("stl", "ascii.stl", stl_ascii())
     zarr_seeds()
-    one = shard_set("--size", "6", "--block", "5")
+    one = shard_set("--demo", "sphere", "--size", "6", "--block", "5")
     write("shards", "one-as-is", one(members=False))
     write("shards", "one-members", one(members=True))
     lps = {"linear": [[0, 1, 0], [-1, 0, 0], [0, 0, 2]], "offset": [10, 20, 30], "space": "LPS"}
-    write("shards", "rotated-members", shard_set("--size", "6", "--block", "5", "--no-normals",
-                                                 world=lps)(members=True))
-    write("shards", "eight-members", shard_set("--size", "4", "--block", "2")(members=True))
+    write("shards", "rotated-members", shard_set("--demo", "sphere", "--size", "6", "--block",
+                                                 "5", "--no-normals", world=lps)(members=True))
+    write("shards", "eight-members",
+          shard_set("--demo", "sphere", "--size", "4", "--block", "2")(members=True))
+    table = b'1 255 0 0 1 1 1 "left"\n2 0 0 255 1 1 1 "right"\n'
+    seg = [("seg.raw", label_volume()), ("seg.txt", table)]
+    labels = lambda block, *more: shard_set("seg.raw", "--dims", "6,6,6", "--dtype", "u8",
+                                            "--labels", "1,2,7", "--block", block, *more,
+                                            files=seg)
+    write("shards", "labels-members",
+          labels("4", "--label-table", "seg.txt", "--smoothing", "0.75")(members=True))
+    write("shards", "labels-as-is", labels("8")(members=False))
 
 
 if __name__ == "__main__":

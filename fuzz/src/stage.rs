@@ -43,8 +43,10 @@ pub enum Target {
     /// metadata, OME-Zarr attributes, a level's array and chunks. Read by the build with
     /// sc-io's `zarr` feature (`read_zarr`).
     Zarr,
-    /// `manifest.json` and its shards `s0.npz`, `s1.npz`, …, joined by [`sc_io::shard::merge`]:
-    /// see [`shards`] for how the bytes are cut.
+    /// `manifest.json` and its shards `s0.npz`, `s1.npz`, …, of a scan or of a label volume,
+    /// joined as `skelclimb merge` joins them ([`sc_io::shard::merge`] or
+    /// [`sc_io::labels::merge_shards`], by the manifest's kind): see [`shards`] for how the bytes
+    /// are cut.
     Shards,
 }
 
@@ -188,20 +190,30 @@ impl Target {
                 }
             }
             Target::Shards => {
-                let (_, mesh) = sc_io::shard::merge(path).map_err(|e| e.to_string())?;
-                let n = mesh.positions.len();
-                assert!(
-                    mesh.triangles.iter().flatten().all(|&i| (i as usize) < n),
-                    "a triangle indexes past the {n} vertices"
-                );
-                assert!(
-                    mesh.positions
-                        .iter()
-                        .chain(&mesh.normals)
-                        .flatten()
-                        .all(|c| c.is_finite()),
-                    "a vertex or normal is not finite"
-                );
+                use sc_io::shard::{self, ShardSettings};
+                let text = |e: sc_io::Error| e.to_string();
+                let meshes =
+                    if shard::kind(path).map_err(text)? == sc_io::labels::LabelSettings::KIND {
+                        let (_, labels) = sc_io::labels::merge_shards(path).map_err(text)?;
+                        labels.meshes.into_iter().map(|(_, mesh)| mesh).collect()
+                    } else {
+                        vec![shard::merge(path).map_err(text)?.1]
+                    };
+                for mesh in meshes {
+                    let n = mesh.positions.len();
+                    assert!(
+                        mesh.triangles.iter().flatten().all(|&i| (i as usize) < n),
+                        "a triangle indexes past the {n} vertices"
+                    );
+                    assert!(
+                        mesh.positions
+                            .iter()
+                            .chain(&mesh.normals)
+                            .flatten()
+                            .all(|c| c.is_finite()),
+                        "a vertex or normal is not finite"
+                    );
+                }
             }
             _ => {
                 let grid =
@@ -230,15 +242,19 @@ impl Target {
 /// each a 32-bit little-endian length and that many bytes (fewer at the end), written as `s0.npz`,
 /// `s1.npz`, …. A shard whose first byte is odd is the rest as it is (fuzzing the zip layer);
 /// an even one is its six `.npy` members, each length-prefixed the same way, zipped here with
-/// their CRC-32s right, so that mutations reach the arrays behind the zip's checks.
+/// their CRC-32s right, so that mutations reach the arrays behind the zip's checks: a scan's
+/// members for a first byte of 0 modulo 4, a label shard's (`pairs` for `normals`) for 2.
 fn shards(dir: &Path, data: &[u8]) -> std::io::Result<PathBuf> {
-    const MEMBERS: [&str; 6] = [
-        "header",
-        "keys",
-        "positions",
-        "normals",
-        "triangles",
-        "cubes",
+    const MEMBERS: [[&str; 6]; 2] = [
+        [
+            "header",
+            "keys",
+            "positions",
+            "normals",
+            "triangles",
+            "cubes",
+        ],
+        ["header", "keys", "positions", "pairs", "triangles", "cubes"],
     ];
     fn pieces(mut data: &[u8]) -> impl Iterator<Item = &[u8]> {
         std::iter::from_fn(move || {
@@ -262,7 +278,8 @@ fn shards(dir: &Path, data: &[u8]) -> std::io::Result<PathBuf> {
     for (i, shard) in pieces(data.get(split + 1..).unwrap_or_default()).enumerate() {
         let bytes = match shard.split_first() {
             Some((mode, rest)) if mode % 2 == 0 => {
-                stored_zip(MEMBERS.iter().map(|m| format!("{m}.npy")).zip(pieces(rest)))
+                let members = MEMBERS[usize::from(mode % 4 / 2)];
+                stored_zip(members.iter().map(|m| format!("{m}.npy")).zip(pieces(rest)))
             }
             Some((_, rest)) => rest.to_vec(),
             None => Vec::new(),

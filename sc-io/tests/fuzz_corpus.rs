@@ -70,3 +70,29 @@ fn past_findings_are_refused_with_the_file_named() {
     // Findings are kept, never deleted: an empty folder means the path above is wrong.
     assert!(replayed > 0, "no regression files found");
 }
+
+/// The shards target's label seeds (`labels-*`, fuzz/seeds.py) merge as label shards, staged
+/// from their members and as they are, so that the fuzzer starts from label shards that read.
+#[test]
+fn the_label_shard_seeds_merge() {
+    let seeds: Vec<PathBuf> = files("corpus", Target::Shards)
+        .into_iter()
+        .filter(|f| {
+            f.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("labels-")
+        })
+        .collect();
+    assert_eq!(seeds.len(), 2, "{seeds:?}");
+    for file in seeds {
+        let data = std::fs::read(&file).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        assert_eq!(
+            Target::Shards.run(scratch.path(), &data),
+            Ok(true),
+            "{}",
+            file.display()
+        );
+    }
+}

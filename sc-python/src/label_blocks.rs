@@ -14,16 +14,19 @@ use sc_runtime::labels::{AtlasBlock, Label, LabelParams, block_samples, extract_
 use sc_runtime::{Stats, Volume};
 
 use crate::blocks::rows;
-use crate::convert::{self, with_type};
-use crate::labels::{Reply, TYPES, label, respond};
+use crate::convert;
+use crate::labels::{Reply, label, respond};
 use crate::{errors, extract};
 
 /// Calls `$body` with `$t` bound to the label type of `$array`'s dtype.
 macro_rules! with_label {
     ($py:expr, $array:expr, $name:expr, $t:ident => $body:expr) => {
-        with_type!($py, $array, $name, TYPES, [u8, u16, u32, u64, i16, i32], $t => $body)
+        $crate::convert::with_type!(
+            $py, $array, $name, $crate::labels::TYPES, [u8, u16, u32, u64, i16, i32], $t => $body
+        )
     };
 }
+pub(crate) use with_label;
 
 /// Meshes the cubes `cubes` (`(start, end)` per axis, x, y, z, numbered as
 /// `sc_runtime::labels::block_samples` says) of a volume of `grid` samples from `samples`, a
@@ -130,7 +133,7 @@ pub fn finish_label_blocks<'py>(
 }
 
 /// The pairs array of a share, whose dtype is the share's label type.
-fn pairs_of<'py>(share: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyUntypedArray>> {
+pub fn pairs_of<'py>(share: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyUntypedArray>> {
     share
         .get_item(5)
         .ok()
@@ -156,7 +159,8 @@ fn to_python<'py, L: Label + Element>(
         .into_pyobject(py)
 }
 
-fn from_python<'py, L>(obj: &Bound<'py, PyAny>) -> PyResult<AtlasBlock<L>>
+/// The share `obj`, a tuple as [`to_python`] makes, of label type `L`, checked.
+pub fn from_python<'py, L>(obj: &Bound<'py, PyAny>) -> PyResult<AtlasBlock<L>>
 where
     L: Label + Element + Display + FromPyObjectOwned<'py>,
 {

@@ -9,6 +9,7 @@ mod errors;
 mod extract;
 mod files;
 mod label_blocks;
+mod label_shards;
 mod labels;
 mod recycle;
 mod shards;
@@ -46,6 +47,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shards::write_shard, m)?)?;
     m.add_function(wrap_pyfunction!(shards::write_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(shards::merge_shards, m)?)?;
+    m.add_function(wrap_pyfunction!(shards::shard_kind, m)?)?;
+    m.add_function(wrap_pyfunction!(label_shards::write_label_shard, m)?)?;
+    m.add_function(wrap_pyfunction!(label_shards::write_label_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(label_shards::merge_label_shards, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(arguments::check_threads, m)?)?;
     m.add_function(wrap_pyfunction!(arguments::check_triple, m)?)?;

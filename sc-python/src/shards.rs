@@ -2,19 +2,20 @@
 //! as `skelclimb extract --shards` and returns a small record, so that no worker holds the mesh;
 //! one definition of the format (`sc_io::shard`) serves the command line and Python.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use sc_io::shard::{self, MANIFEST_NAME, Manifest, Settings, ShardEntry};
+use sc_io::shard::{self, MANIFEST_NAME, Manifest, Settings, ShardEntry, ShardSettings};
 
 use crate::blocks::from_python;
 use crate::convert;
 use crate::errors;
 use crate::extract::params;
 
-/// A manifest's record of one shard: `(file, cubes, vertices, triangles)`.
-type Record = (String, [(usize, usize); 3], u64, u64);
+/// A manifest's record of one shard: `(file, cubes, vertices, triangles)`, what a task returns
+/// instead of its share (of either kind).
+pub type Record = (String, [(usize, usize); 3], u64, u64);
 
 /// The settings of every block of one mesh, as `skelclimb.dask` passes them: `(level, spacing,
 /// origin, mode, normals, max_error)`, the arguments of `extract_block` in its order.
@@ -46,7 +47,7 @@ pub fn write_shard(
     Ok(record(entry))
 }
 
-fn record(e: ShardEntry) -> Record {
+pub fn record(e: ShardEntry) -> Record {
     (
         e.file,
         e.cubes.map(|r| (r.start, r.end)),
@@ -64,7 +65,20 @@ pub fn write_manifest(
     records: Vec<Record>,
     made_with: SettingsArgs,
 ) -> PyResult<PathBuf> {
-    let mut manifest = Manifest::new(grid, &settings(made_with)?);
+    write_listing(
+        &directory,
+        Manifest::new(grid, &settings(made_with)?),
+        records,
+    )
+}
+
+/// Writes `manifest`, listing the shards `records`, into `directory` (of any kind of shards);
+/// returns its path.
+pub fn write_listing<S: ShardSettings>(
+    directory: &Path,
+    mut manifest: Manifest<S>,
+    records: Vec<Record>,
+) -> PyResult<PathBuf> {
     manifest.shards = records
         .into_iter()
         .map(|(file, cubes, vertices, triangles)| ShardEntry {
@@ -77,8 +91,14 @@ pub fn write_manifest(
     let path = directory.join(MANIFEST_NAME);
     manifest.write(&path).map_err(errors::io)?;
     // Read back: the same checks `merge` makes, now rather than on another machine later.
-    Manifest::<Settings>::read(&path).map_err(errors::io)?;
+    Manifest::<S>::read(&path).map_err(errors::io)?;
     Ok(path)
+}
+
+/// The kind of shards the manifest at `manifest` lists: `"surface"` or `"labels"`.
+#[pyfunction]
+pub fn shard_kind(manifest: PathBuf) -> PyResult<String> {
+    shard::kind(&manifest).map_err(errors::io)
 }
 
 /// Joins the shards a manifest lists: `(vertices, faces, normals or None, stats)`.

@@ -280,3 +280,12 @@ def test_cluster_of_two_processes_writes_shards_that_merge_exactly(cluster, stor
     path, v = store
     manifest = skelclimb.dask.extract(da.from_zarr(path), 12, shards=tmp_path / "parts")
     same(skelclimb.merge_shards(manifest), skelclimb.extract(v, 12))
+
+
+def test_cluster_of_two_processes_writes_label_shards_that_merge_exactly(cluster, tmp_path):
+    from test_dask_labels import same as same_labels, volume
+
+    v = volume((30, 28, 26), 12, 5)
+    manifest = skelclimb.dask.labels(da.from_array(v, chunks=10), smoothing=0.75,
+                                     shards=tmp_path / "labels")
+    same_labels(skelclimb.merge_shards(manifest), skelclimb.labels(v, smoothing=0.75))

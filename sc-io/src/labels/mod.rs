@@ -20,7 +20,7 @@ mod shard;
 mod stream;
 
 pub use mesh::{LabelMeshes, LabelRequest, Selection, extract};
-pub use shard::{LabelSettings, extract_shards, merge_shards};
+pub use shard::{LabelSettings, Stored, extract_shards, join_shards, merge_shards, write_block};
 pub use stream::extract_stream;
 
 use std::collections::BTreeMap;

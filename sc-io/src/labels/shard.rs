@@ -10,9 +10,10 @@
 //! by, and what only the merge uses: the selection, whether meshes get normals, and the label
 //! table (names and colours), which the shards leave out.
 
+use std::ops::Range;
 use std::path::Path;
 
-use sc_runtime::labels::{AtlasBlock, Label as Sample, LabelParams, extract_block};
+use sc_runtime::labels::{Atlas, AtlasBlock, Label as Sample, LabelParams, extract_block};
 use sc_runtime::{Mode, Volume};
 use serde_json::{Value, json};
 
@@ -76,6 +77,21 @@ impl LabelSettings {
             selection: request.selection.clone(),
             table: table.cloned(),
         }
+    }
+
+    /// The background as a label of type `L`, the label type of the manifest at `path`; a
+    /// background that does not fit it is a bad manifest.
+    pub fn background_label<L: TryFrom<u64>>(&self, path: &Path) -> Result<L> {
+        L::try_from(self.background).map_err(|_| {
+            Error::file(
+                path,
+                format!(
+                    "not a shard manifest: background {} does not fit its {} labels",
+                    self.background,
+                    self.dtype.name()
+                ),
+            )
+        })
     }
 
     /// The request the merge cuts the meshes by.
@@ -250,8 +266,11 @@ struct Job<'a> {
     progress: &'a dyn Progress,
 }
 
-/// A label type shards store: one NumPy has.
-trait Stored: Sample + TryFrom<u64> + TryInto<i64> + npyz::AutoSerialize + npyz::Deserialize {}
+/// A label type shards store (their `pairs`): one NumPy has.
+pub trait Stored:
+    Sample + TryFrom<u64> + TryInto<i64> + npyz::AutoSerialize + npyz::Deserialize
+{
+}
 impl<L: Sample + TryFrom<u64> + TryInto<i64> + npyz::AutoSerialize + npyz::Deserialize> Stored
     for L
 {
@@ -302,18 +321,31 @@ fn write_blocks<L: Stored>(
         let at = need.clone().map(|r| r.start);
         let volume = Volume::new(&samples, need.map(|r| r.len()))?;
         let share = extract_block(volume, at, dims, cubes.clone(), params)?;
-        let entry = ShardEntry {
-            file: ShardEntry::file_name(&cubes),
-            cubes,
-            vertices: share.keys.len() as u64,
-            triangles: share.triangles.len() as u64,
-        };
-        write_shard(&dir.join(&entry.file), &share, &manifest.settings)?;
+        let entry = write_block(dir, cubes, &share, &manifest.settings)?;
         manifest.shards.push(entry);
         progress.inc(1);
     }
     manifest.write(&dir.join(MANIFEST_NAME))?;
     Ok(manifest)
+}
+
+/// Writes `share`, owning `cubes` and swept with `settings` (of its label type), to its shard
+/// file in `dir`, whole or not at all, and returns the manifest's entry for it: the one writer of
+/// label shards, for the command line and Python's Dask driver.
+pub fn write_block<L: Stored>(
+    dir: &Path,
+    cubes: [Range<usize>; 3],
+    share: &AtlasBlock<L>,
+    settings: &LabelSettings,
+) -> Result<ShardEntry> {
+    let entry = ShardEntry {
+        file: ShardEntry::file_name(&cubes),
+        cubes,
+        vertices: share.keys.len() as u64,
+        triangles: share.triangles.len() as u64,
+    };
+    write_shard(&dir.join(&entry.file), share, settings)?;
+    Ok(entry)
 }
 
 /// Writes `share`, swept with `settings`, to the shard file `path`, whole or not at all.
@@ -406,17 +438,20 @@ pub fn merge_shards(manifest_path: &Path) -> Result<(Manifest<LabelSettings>, La
 
 fn merge_typed<L: Stored>(path: &Path, manifest: &Manifest<LabelSettings>) -> Result<LabelMeshes> {
     let settings = &manifest.settings;
+    let background = settings.background_label::<L>(path)?;
+    let atlas = join_shards::<L>(path, manifest)?;
+    mesh::select(atlas, background, &settings.request()).map_err(|e| match e {
+        Error::Usage(message) => Error::file(path, message),
+        e => e,
+    })
+}
+
+/// Joins the label shards `manifest` (read from `path`) lists into the atlas of the whole
+/// volume, before any placement or selection: for a front end that cuts the meshes itself.
+/// `L` is the manifest's label type ([`LabelSettings::dtype`]), which the caller dispatches on
+/// (pairs of another type do not read). Holds about the atlas plus one shard at a time.
+pub fn join_shards<L: Stored>(path: &Path, manifest: &Manifest<LabelSettings>) -> Result<Atlas<L>> {
     let at_manifest = |e: sc_runtime::Error| Error::file(path, e.to_string());
-    let background = L::try_from(settings.background).map_err(|_| {
-        Error::file(
-            path,
-            format!(
-                "not a shard manifest: background {} does not fit its {} labels",
-                settings.background,
-                settings.dtype.name()
-            ),
-        )
-    })?;
     let mut shares = Joiner::default();
     for entry in &manifest.shards {
         let share = read_checked::<L>(&shard::shard_path(path, entry), entry, manifest)?;
@@ -424,13 +459,9 @@ fn merge_typed<L: Stored>(path: &Path, manifest: &Manifest<LabelSettings>) -> Re
     }
     let mut joined = shares.finish().map_err(at_manifest)?;
     if joined.grid == [0; 3] {
-        (joined.grid, joined.pad) = (manifest.grid, settings.pad);
+        (joined.grid, joined.pad) = (manifest.grid, manifest.settings.pad);
     }
-    let atlas = joined.into_atlas().map_err(at_manifest)?;
-    mesh::select(atlas, background, &settings.request()).map_err(|e| match e {
-        Error::Usage(message) => Error::file(path, message),
-        e => e,
-    })
+    joined.into_atlas().map_err(at_manifest)
 }
 
 #[cfg(test)]

@@ -486,22 +486,36 @@ class SliceStreamer:
 
 
 def merge_shards(manifest):
-    """Joins the shards a manifest lists into one :class:`Mesh`.
+    """Joins the shards a manifest lists: a :class:`Mesh` for shards of a scan, a
+    :class:`Labels` for those of a label volume.
 
-    ``manifest`` is the path :func:`skelclimb.dask.extract` returns with ``shards=``, or the
-    ``manifest.json`` that ``skelclimb extract --shards`` writes. The result is exactly the mesh
-    a single :func:`extract` of the whole volume gives. A missing, damaged or foreign shard, or
-    blocks missing or listed twice, raise ``OSError`` naming the file.
+    ``manifest`` is the path :func:`skelclimb.dask.extract` or :func:`skelclimb.dask.labels`
+    returns with ``shards=``, or the ``manifest.json`` that ``skelclimb extract --shards``
+    writes. The result is exactly what a single :func:`extract` or :func:`labels` of the whole
+    volume gives with the settings the manifest records. One function for both kinds, as
+    ``skelclimb merge`` is one command: the manifest names its kind, so a caller need not.
+    Labels come back in the type the sweep ran on (the volume's own, but for int8, int64 and
+    uint64 volumes, which :func:`labels` converts). A missing, damaged or foreign shard (of
+    another volume, other settings or the other kind), or blocks missing or listed twice, raise
+    ``OSError`` naming the file.
 
     >>> import numpy as np, tempfile, skelclimb, skelclimb.dask, dask.array as da
     >>> v = np.zeros((12, 12, 12), np.uint8); v[3:9, 3:9, 3:9] = 1
     >>> path = skelclimb.dask.extract(da.from_array(v, chunks=6), 1, shards=tempfile.mkdtemp())
     >>> skelclimb.merge_shards(path).faces.shape == skelclimb.extract(v, 1).faces.shape
     True
+    >>> path = skelclimb.dask.labels(da.from_array(v, chunks=6), shards=tempfile.mkdtemp())
+    >>> skelclimb.merge_shards(path)[1].faces.shape == skelclimb.labels(v)[1].faces.shape
+    True
     """
     import os
 
-    verts, faces, norms, stats = _native.merge_shards(os.fsdecode(manifest))
+    manifest = os.fsdecode(manifest)
+    if _native.shard_kind(manifest) == "labels":
+        from ._labels import _result
+
+        return _result(_native.merge_label_shards(manifest))
+    verts, faces, norms, stats = _native.merge_shards(manifest)
     return Mesh(verts, faces, norms, stats)
 
 

@@ -248,10 +248,11 @@ def labels(
     ), dtype)
 
 
-def _result(native, dtype):
-    """The :class:`Labels` of what ``_native.labels`` returns, its labels of ``dtype``."""
+def _result(native, dtype=None):
+    """The :class:`Labels` of what ``_native.labels`` returns, its labels of ``dtype`` (by
+    default, of the type they come in)."""
     verts, faces, face_labels, meshes, stats = native
-    if face_labels.dtype != dtype:
+    if dtype is not None and face_labels.dtype != dtype:
         face_labels = face_labels.astype(dtype)
     return Labels(
         {label: Mesh(v, f, n, s) for label, v, f, n, s in meshes},

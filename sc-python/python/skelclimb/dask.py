@@ -100,16 +100,40 @@ def _native_settings(options):
             bool(options["normals"]), _bound(options["max_error"], options["error_units"]))
 
 
-def _shard(directory, block, at, grid, cubes, *shells_and_options):
-    """Meshes one block and writes it as a shard; returns only the manifest's small record, so
-    the worker keeps no mesh."""
-    options = shells_and_options[-1]
-    share = _mesh(block, at, grid, cubes, *shells_and_options)
+def _label_settings(o):
+    """A label volume's settings as the native label shard writer takes them: one tuple."""
+    return (o["background"], o["mode"], o["pad"], o["spacing"], o["origin"], o["smoothing"],
+            o["affine"], o["space"], o["normals"], o["selection"])
+
+
+def _surface_shard(share, directory, cubes, options):
     return _native.write_shard(share._share, directory, cubes, _native_settings(options))
 
 
-def _manifest(directory, grid, options, *records):
-    return str(_native.write_manifest(directory, grid, list(records), _native_settings(options)))
+def _surface_manifest(directory, grid, records, options):
+    return _native.write_manifest(directory, grid, records, _native_settings(options))
+
+
+def _label_shard(share, directory, cubes, options):
+    return _native.write_label_shard(share, directory, cubes, _label_settings(options))
+
+
+def _label_manifest(directory, grid, records, options):
+    return _native.write_label_manifest(directory, grid, records, options["dtype"],
+                                        _label_settings(options))
+
+
+def _shard(directory, mesh, write, block, at, grid, cubes, *shells_and_options):
+    """Meshes one block with ``mesh`` and writes its share as a shard with ``write`` (one of
+    the ``_*_shard`` functions); returns only the manifest's small record, so the worker keeps
+    no mesh."""
+    share = mesh(block, at, grid, cubes, *shells_and_options)
+    return write(share, directory, cubes, shells_and_options[-1])
+
+
+def _manifest(directory, write, grid, options, *records):
+    """Writes the manifest listing ``records`` with ``write`` (a ``_*_manifest`` function)."""
+    return str(write(directory, grid, list(records), options))
 
 
 def _merge(*shares):
@@ -217,17 +241,16 @@ def extract(array, level, *, spacing=(1, 1, 1), origin=(0, 0, 0), mode="embedded
     if directory is not None:
         os.makedirs(directory, exist_ok=True)
     token = tokenize(array.name, options, split_every, directory)
+    shards = None if directory is None else (directory, _surface_shard, _surface_manifest)
     array, name, blocks, shares = _blocks(
-        array, token, before, after, False,
-        lambda *task: (_mesh, *task, options) if directory is None
-        else (_shard, directory, *task, options))
+        array, token, before, after, False, _mesh, options, shards)
     return _run(array, name, blocks, shares, token, split_every, compute, _merge, _finish,
-                directory=directory, grid=grid, options=options)
+                shards=shards, grid=grid, options=options)
 
 
 def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=None,
            background=0, mode="embedded", pad=True, normals=True, smoothing=0, split_every=8,
-           compute=True):
+           shards=None, compute=True):
     """Meshes every region of a 3-D integer ``dask.array``, block by block: exactly what
     :func:`skelclimb.labels` makes of the whole array.
 
@@ -248,14 +271,25 @@ def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=
         As for :func:`skelclimb.labels`.
     split_every : int
         How many shares each merge task joins (the fan-in of the reduction tree).
+    shards : str or os.PathLike, optional
+        A directory (made if missing) on storage every worker can write to. Each task then
+        writes its block's share of the atlas there as a label shard, the files
+        ``skelclimb extract --labels --shards`` writes, and the result is the path of
+        ``manifest.json`` listing them. :func:`skelclimb.merge_shards` joins them into the
+        :class:`skelclimb.Labels` this call would return, ``skelclimb merge`` into the files
+        ``skelclimb extract --labels`` writes. Label shards hold the labels of the command
+        line: uint64 volumes, negative labels and a negative background are a ``ValueError``
+        here, and a volume holding negative labels merges in Python only. A selection
+        (``labels``) naming a label without a surface is reported by the merge.
     compute : bool
         Return the result; with ``False``, a ``dask.delayed`` object that computes it.
 
     Returns
     -------
-    skelclimb.Labels
+    skelclimb.Labels or str
         Equal, vertex for vertex and triangle for triangle, to ``skelclimb.labels`` of the
-        whole array with the same arguments, whatever the chunking.
+        whole array with the same arguments, whatever the chunking; with ``shards``, the
+        manifest's path.
 
     Examples
     --------
@@ -301,10 +335,15 @@ def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=
                  smoothing=smoothing, affine=affine, space=space)
     finish = dict(background=background, mode=mode, normals=bool(normals), selection=selection,
                   affine=affine, space=space, dtype=dtype)
-    token = tokenize(array.name, block, finish, split_every)
+    directory = None if shards is None else os.fspath(shards)
+    if directory is not None:
+        block.update(_label_shard_settings(target, background, selection), normals=bool(normals))
+        os.makedirs(directory, exist_ok=True)
+    token = tokenize(array.name, block, finish, split_every, directory)
+    shards = None if directory is None else (directory, _label_shard, _label_manifest)
     array, name, blocks, shares = _blocks(
-        array, token, before, after, pad, lambda *task: (_label_mesh, *task, block))
-    if not shares:
+        array, token, before, after, pad, _label_mesh, block, shards)
+    if not shares and shards is None:
         # No cube at all (an axis of one sample, unpadded): no blocks to split it into.
         import dask
 
@@ -313,14 +352,38 @@ def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=
         result = dask.delayed(whole)(source, **given)
         return result.compute() if compute else result
     return _run(array, name, blocks, shares, token, split_every, compute, _label_merge,
-                lambda share: _label_finish(share, finish))
+                lambda share: _label_finish(share, finish), shards=shards, grid=grid,
+                options=block)
 
 
-def _blocks(array, token, before, after, pad, task):
+def _label_shard_settings(dtype, background, selection):
+    """What label shards record besides the sweep's settings: the label type, the selection;
+    a ``ValueError`` for the labels they cannot hold (as the command line's ``--labels`` and
+    ``--background``: 0 or more, in uint8, int16, uint16, uint32 or int32)."""
+    if dtype == np.uint64:
+        raise ValueError("shards: the array's labels are uint64; label shards hold uint8, "
+                         "int16, uint16, uint32 or int32")
+    if background < 0:
+        raise ValueError(f"shards: background {background} is negative; label shards hold "
+                         "labels 0 or more")
+    if selection is not None:
+        if not selection:
+            raise ValueError("labels: the selection is empty; pass None to mesh every label")
+        if selection[0] < 0:
+            raise ValueError(f"shards: labels: {selection[0]} is negative; label shards hold "
+                             "labels 0 or more")
+        if background in selection:
+            raise ValueError(f"labels: {background} is the background, which is not meshed; "
+                             "pass background= another value to mesh it")
+    return dict(dtype=np.dtype(dtype).name, selection=selection)
+
+
+def _blocks(array, token, before, after, pad, mesh, options, shards=None):
     """The tasks meshing ``array`` block by block: ``(array, name, blocks, shares)``, the array
     rechunked so that a halo comes from one neighbour, the blocks' layer name, its tasks (the
-    shells, then ``task(chunk, at, grid, cubes, *shells)`` per chunk owning cubes, keyed
-    ``(name, *idx)``) and those blocks' keys. A block's task gets its chunk plus the halo it
+    shells, then ``mesh(chunk, at, grid, cubes, *shells, options)`` per chunk owning cubes,
+    keyed ``(name, *idx)``; with ``shards``, ``(directory, write, _)``, that share written by
+    :func:`_shard` instead) and those blocks' keys. A block's task gets its chunk plus the halo it
     reads, ``before`` samples before it and ``after`` past it, cut from its 26 neighbours'
     shells (see _shell): three tasks per chunk (read, shell, mesh) where dask.array.overlap
     makes some 24, and every chunk read once."""
@@ -356,16 +419,19 @@ def _blocks(array, token, before, after, pad, task):
                 at = tuple(max(s - before, 0) for s in first)
                 idx = (iz, iy, ix)
                 key = (name, *idx)
-                blocks[key] = task(chunks[idx], at, grid, (cx, cy, cz), *shells(idx))
+                task = (chunks[idx], at, grid, (cx, cy, cz), *shells(idx), options)
+                blocks[key] = ((mesh, *task) if shards is None
+                               else (_shard, shards[0], mesh, shards[1], *task))
                 shares.append(key)
     return array, name, blocks, shares
 
 
 def _run(array, name, blocks, shares, token, split_every, compute, merge, finish,
-         directory=None, grid=None, options=None):
+         shards=None, grid=None, options=None):
     """Runs the blocks' graph: their shares joined by ``merge`` in a tree of fan-in
     ``split_every``, the last join and ``finish`` here (or, without ``compute``, a delayed
-    object doing both); with ``directory``, the shards' manifest's path instead."""
+    object doing both); with ``shards`` (``(directory, _, write_manifest)``), the path of the
+    manifest listing the shards the blocks wrote instead."""
     import dask
     from dask.delayed import Delayed
     from dask.highlevelgraph import HighLevelGraph, MaterializedLayer
@@ -379,8 +445,9 @@ def _run(array, name, blocks, shares, token, split_every, compute, merge, finish
                                                           "priority": _by_z_layer})
     dependencies[name] = set(array.__dask_layers__())
     joins, last = {}, name
-    if directory is not None:
-        joins["skelclimb-manifest-" + token] = (_manifest, directory, grid, options, *shares)
+    if shards is not None:
+        joins["skelclimb-manifest-" + token] = (_manifest, shards[0], shards[2], grid, options,
+                                                *shares)
         shares = ["skelclimb-manifest-" + token]
     else:
         level_key = 0
@@ -401,7 +468,7 @@ def _run(array, name, blocks, shares, token, split_every, compute, merge, finish
         dependencies[last] = {name}
     graph = HighLevelGraph(layers, dependencies)
     results = [Delayed(key, graph, layer=last) for key in shares]
-    if directory is not None or not compute:
+    if shards is not None or not compute:
         return results[0].compute() if compute else results[0]
     # The last merge runs here, where the mesh is wanted anyway, so that no worker has to hold
     # the whole mesh (and its inputs) on top of its chunks.

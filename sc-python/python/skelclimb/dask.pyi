@@ -32,5 +32,6 @@ def labels(
     normals: bool = ...,
     smoothing: float = ...,
     split_every: int = ...,
+    shards: _Path | None = ...,
     compute: bool = ...,
-) -> Labels | Any: ...
+) -> Labels | str | Any: ...
