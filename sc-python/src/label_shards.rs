@@ -177,6 +177,8 @@ where
         background,
         mode: s.mode.name(),
         normals: s.normals,
+        // A call in the user's process, as `labels` is: every core.
+        threads: 0,
         selection,
     };
     respond(py, atlas, reply)
