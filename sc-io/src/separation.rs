@@ -23,6 +23,9 @@
 
 use sc_runtime::{Mesh, Params, Scalar, Volume};
 
+/// The figure's name in every front end's statistics (`--stats-json`, Python's `stats`).
+pub const WRONG_SIDE_SAMPLES: &str = "wrong_side_samples";
+
 /// Fraction bits of the fixed-point grid coordinates: 2⁻²⁰ grid steps, far below any sample's
 /// distance from the extractor's surface, while products of differences stay within `i128`
 /// for grids of up to 2³⁰ samples a side.
@@ -65,18 +68,31 @@ pub fn wrong_side_samples<T: Scalar>(
             }
         }
     }
-    let crossings = Crossings::new(mesh, params, [ny, nz]);
+    let crossings = Crossings::new(mesh, params, [nx, ny, nz]);
+    let count = |flags: &[u8]| flags.iter().map(|&f| u64::from(f)).sum::<u64>();
+    let mut on = crossings.on.iter().peekable();
     let mut wrong = 0u64;
     for z in 0..nz {
         for y in 0..ny {
+            let r = y + ny * z;
             T::classify_row(row(y, z), threshold, &mut filled);
-            let xs = crossings.row(y + ny * z);
-            let mut behind = 0;
-            for (x, &f) in filled.iter().enumerate() {
-                while behind < xs.len() && xs[behind] <= x as f64 {
-                    behind += 1;
-                }
-                wrong += u64::from((behind & 1) as u8 != f);
+            let xs = crossings.row(r);
+            // The filled samples outside the mesh, and the empty ones inside: sample `x` is
+            // inside where an odd number of crossings lie at or behind it, that is from
+            // `⌈xs[2k]⌉` up to `⌈xs[2k + 1]⌉`, past it.
+            wrong += count(&filled);
+            for pair in xs.chunks(2) {
+                let at = |i: usize| {
+                    pair.get(i)
+                        .map_or(nx, |&x| x.ceil().clamp(0.0, nx as f64) as usize)
+                };
+                let inside = &filled[at(0)..at(1).max(at(0))];
+                wrong = wrong + inside.len() as u64 - 2 * count(inside);
+            }
+            // A sample on the surface is on neither side: take back any counted.
+            while let Some(&(_, x)) = on.next_if(|&&(row, _)| row == r) {
+                let inside = xs.partition_point(|&c| c <= x as f64) % 2 == 1;
+                wrong -= u64::from(inside != (filled[x] == 1));
             }
         }
     }
@@ -84,15 +100,17 @@ pub fn wrong_side_samples<T: Scalar>(
 }
 
 /// The x (in grid steps) of every crossing of the mesh with every row of samples, grouped by
-/// row (`y + ny · z`) and sorted within each.
+/// row (`y + ny · z`) and sorted within each, and the samples on the surface.
 struct Crossings {
     /// Where each row's crossings start in `xs`; one more entry than rows.
     start: Vec<usize>,
     xs: Vec<f64>,
+    /// The samples on the surface, `(row, x)`, sorted, once each.
+    on: Vec<(usize, usize)>,
 }
 
 impl Crossings {
-    fn new(mesh: &Mesh, params: &Params, [ny, nz]: [usize; 2]) -> Crossings {
+    fn new(mesh: &Mesh, params: &Params, [nx, ny, nz]: [usize; 3]) -> Crossings {
         let grid: Vec<[f64; 3]> = mesh
             .positions
             .iter()
@@ -100,35 +118,63 @@ impl Crossings {
                 std::array::from_fn(|d| (f64::from(p[d]) - params.origin[d]) / params.spacing[d])
             })
             .collect();
-        let fixed: Vec<[i64; 2]> = grid
+        let fixed: Vec<[i64; 3]> = grid
             .iter()
-            .map(|g| [g[1], g[2]].map(|c| (c * ONE as f64).round() as i64))
+            .map(|g| g.map(|c| (c * ONE as f64).round() as i64))
             .collect();
         let mut found: Vec<(usize, f64)> = Vec::new();
+        let mut on: Vec<(usize, usize)> = Vec::new();
         for t in &mesh.triangles {
-            let t = t.map(|i| i as usize);
-            let [a, b, c] = t.map(|i| fixed[i]);
-            // The rows the projection can cover: `min ≤ row < max` on each axis (the row is
-            // moved up by ε), within the grid.
+            let p = t.map(|i| fixed[i as usize]);
+            let [a, b, c] = p.map(|v| [v[1], v[2]]);
+            let area = det(a, b, c);
+            // The rows its closed projection covers, within the grid.
             let span = |d: usize, n: usize| {
-                let lo = a[d].min(b[d]).min(c[d]);
-                let hi = a[d].max(b[d]).max(c[d]);
-                let lo = ceil_steps(lo).max(0);
-                let hi = ceil_steps(hi).min(n as i64);
-                lo..hi
+                let lo = p.iter().map(|v| v[d]).min().unwrap_or(0);
+                let hi = p.iter().map(|v| v[d]).max().unwrap_or(-1);
+                ceil_steps(lo).max(0)..=floor_steps(hi).min(n as i64 - 1)
             };
-            for z in span(1, nz) {
-                for y in span(0, ny) {
+            for z in span(2, nz) {
+                for y in span(1, ny) {
                     let q = [y * ONE, z * ONE];
-                    let s = [side(b, c, q), side(c, a, q), side(a, b, q)];
-                    if s[0] == 0 || s[0] != s[1] || s[0] != s[2] {
+                    let row = y as usize + ny * z as usize;
+                    if area == 0 {
+                        // Parallel to x: no moved row crosses it, but samples can lie on it.
+                        if let Some(xs) = along(p, q) {
+                            let xs = (*xs.start()).max(0)..=(*xs.end()).min(nx as i64 - 1);
+                            on.extend(xs.map(|x| (row, x as usize)));
+                        }
                         continue;
                     }
-                    // Barycentric weights at the row itself: all of one sign, not all zero.
-                    let w = [det(b, c, q), det(c, a, q), det(a, b, q)].map(|w| w as f64);
-                    let x =
-                        (0..3).map(|k| w[k] * grid[t[k]][0]).sum::<f64>() / w.iter().sum::<f64>();
-                    found.push((y as usize + ny * z as usize, x));
+                    // Barycentric weights at the row itself, exactly: of `area`'s sign where
+                    // the closed triangle covers the row.
+                    let w = [det(b, c, q), det(c, a, q), det(a, b, q)];
+                    if w.iter().any(|&w| w != 0 && (w > 0) != (area > 0)) {
+                        continue;
+                    }
+                    let x = (0..3)
+                        .map(|k| w[k] as f64 * grid[t[k] as usize][0])
+                        .sum::<f64>()
+                        / area as f64;
+                    // Where the crossing lies against the nearest sample, exactly.
+                    let near = x.round();
+                    let past: i128 = (0..3)
+                        .map(|k| w[k] * i128::from(p[k][0] - near as i64 * ONE))
+                        .sum::<i128>()
+                        * area.signum();
+                    if past == 0 && (0.0..nx as f64).contains(&near) {
+                        on.push((row, near as usize));
+                    }
+                    let s = [side(b, c, q), side(c, a, q), side(a, b, q)];
+                    if s[0] == s[1] && s[1] == s[2] {
+                        let x = match past.signum() {
+                            0 => near,
+                            1 if x <= near => near + 0.5,
+                            -1 if x >= near => near - 0.5,
+                            _ => x,
+                        };
+                        found.push((row, x));
+                    }
                 }
             }
         }
@@ -149,12 +195,65 @@ impl Crossings {
         for r in 0..ny * nz {
             xs[start[r]..start[r + 1]].sort_unstable_by(f64::total_cmp);
         }
-        Crossings { start, xs }
+        on.sort_unstable();
+        on.dedup();
+        Crossings { start, xs, on }
     }
 
     fn row(&self, r: usize) -> &[f64] {
         &self.xs[self.start[r]..self.start[r + 1]]
     }
+}
+
+/// The samples `x` (integers, unbounded) at which the triangle `p`, whose projection has no
+/// area, meets the row `q`: where the row lies on the projection of a side, the side meets the
+/// row's line at one x (both ends, for a side along x), and the triangle meets it between the
+/// least and the greatest of those.
+fn along(p: [[i64; 3]; 3], q: [i64; 2]) -> Option<std::ops::RangeInclusive<i64>> {
+    let (mut lo, mut hi) = (i64::MAX, i64::MIN);
+    let mut meet = |num: i128, den: i128| {
+        // `num / den` in fixed point, `den > 0`: the samples from its ceiling to its floor.
+        let steps = den * i128::from(ONE);
+        lo = lo.min(-((-num).div_euclid(steps)) as i64);
+        hi = hi.max(num.div_euclid(steps) as i64);
+    };
+    for (e, f) in [(p[0], p[1]), (p[1], p[2]), (p[2], p[0])] {
+        let (eu, fu) = ([e[1], e[2]], [f[1], f[2]]);
+        if det(eu, fu, q) != 0 {
+            continue;
+        }
+        if eu == fu {
+            if eu == q {
+                meet(e[0].into(), 1);
+                meet(f[0].into(), 1);
+            }
+            continue;
+        }
+        // Along the coordinate in which the side's projection is longer.
+        let d = if (f[1] - e[1]).abs() >= (f[2] - e[2]).abs() {
+            1
+        } else {
+            2
+        };
+        let (s0, s1, sq) = (e[d], f[d], q[d - 1]);
+        if sq < s0.min(s1) || sq > s0.max(s1) {
+            continue;
+        }
+        let num =
+            i128::from(e[0]) * i128::from(s1 - s0) + i128::from(f[0] - e[0]) * i128::from(sq - s0);
+        let den = i128::from(s1 - s0);
+        if den > 0 {
+            meet(num, den);
+        } else {
+            meet(-num, -den);
+        }
+    }
+    (lo <= hi).then_some(lo..=hi)
+}
+
+/// `⌊v / ONE⌋` for a fixed-point `v`.
+fn floor_steps(v: i64) -> i64 {
+    v >> FRAC
 }
 
 /// `⌈v / ONE⌉` for a fixed-point `v`.
@@ -250,20 +349,59 @@ mod tests {
         assert_eq!(count(&data, dims, &params, &Mesh::default()), Some(8));
     }
 
-    /// Faces through samples, every vertex on a row: a sample on the surface takes the side of
-    /// the point just past it along +x, moved off its row by (ε, ε²), so the box [2, 4]³ holds
-    /// the samples of [2, 4)³.
+    /// Faces, sides and corners through samples, every vertex on a row: a sample on the
+    /// surface is on neither side, and the others are counted exactly.
     #[test]
-    fn samples_on_the_surface_count_by_the_moved_point() {
+    fn samples_on_the_surface_never_count() {
         let dims = [7; 3];
-        let data = volume(dims, &block(2, 4));
         let params = Params::new(1.0);
+        // Filled [2, 4)³ has 26 samples on the box [2, 4]³, (3, 3, 3) inside.
+        let data = volume(dims, &block(2, 4));
         assert_eq!(count(&data, dims, &params, &cube(2.0, 4.0)), Some(0));
-        assert_eq!(count(&data, dims, &params, &cube(2.0, 5.0)), Some(27 - 8));
-        // Wound inward, the same parity.
-        let mut inward = cube(2.0, 4.0);
+        // Inside [2, 5]³: {3, 4}³, of which only (3, 3, 3) is filled.
+        assert_eq!(count(&data, dims, &params, &cube(2.0, 5.0)), Some(7));
+        assert_eq!(count(&data, dims, &params, &cube(1.0, 4.0)), Some(0));
+        // Wound inward, the same.
+        let mut inward = cube(2.0, 5.0);
         inward.triangles.iter_mut().for_each(|t| t.swap(1, 2));
-        assert_eq!(count(&data, dims, &params, &inward), Some(0));
+        assert_eq!(count(&data, dims, &params, &inward), Some(7));
+        // (3, 3, 3) at a corner of [3, 4]³, empty or filled.
+        for ones in [vec![], vec![[3, 3, 3]]] {
+            let data = volume(dims, &ones);
+            assert_eq!(count(&data, dims, &params, &cube(3.0, 4.0)), Some(0));
+            let inside = count(&data, dims, &params, &cube(2.5, 3.5));
+            assert_eq!(inside, Some(u64::from(ones.is_empty())));
+        }
+    }
+
+    /// A slanted face through samples: the tetrahedron `x, y, z ≥ 1, x + y + z ≤ 7` holds
+    /// (2, 2, 2) alone; the samples of its faces, filled or not, never count.
+    #[test]
+    fn samples_on_a_slanted_face_never_count() {
+        let dims = [8; 3];
+        let params = Params::new(1.0);
+        let tetrahedron = Mesh {
+            positions: vec![[1.0; 3], [5.0, 1.0, 1.0], [1.0, 5.0, 1.0], [1.0, 1.0, 5.0]],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            ..Mesh::default()
+        };
+        let mut face = block(1, 6);
+        face.retain(|p| {
+            let sum = p.iter().sum::<usize>();
+            sum == 7 || sum < 7 && p.contains(&1)
+        });
+        assert!(face.contains(&[2, 2, 3]) && face.contains(&[1, 4, 1]));
+        for (ones, wrong) in [(vec![], 1), (vec![[2, 2, 2]], 0), (face.clone(), 1)] {
+            let data = volume(dims, &ones);
+            assert_eq!(
+                count(&data, dims, &params, &tetrahedron),
+                Some(wrong),
+                "{ones:?}"
+            );
+        }
+        face.push([2, 2, 2]);
+        let data = volume(dims, &face);
+        assert_eq!(count(&data, dims, &params, &tetrahedron), Some(0));
     }
 
     #[test]
