@@ -156,16 +156,21 @@ impl Crossings {
                         .map(|k| w[k] as f64 * grid[t[k] as usize][0])
                         .sum::<f64>()
                         / area as f64;
-                    // Where the crossing lies against the nearest sample, exactly.
+                    // Where the crossing lies against the nearest sample: exactly where `x`,
+                    // good to some 10⁻⁹ steps, cannot tell.
                     let near = x.round();
-                    let past: i128 = (0..3)
-                        .map(|k| w[k] * i128::from(p[k][0] - near as i64 * ONE))
-                        .sum::<i128>()
-                        * area.signum();
+                    let past = if (x - near).abs() > 1e-6 {
+                        (x - near).signum() as i128
+                    } else {
+                        (0..3)
+                            .map(|k| w[k] * i128::from(p[k][0] - near as i64 * ONE))
+                            .sum::<i128>()
+                            * area.signum()
+                    };
                     if past == 0 && (0.0..nx as f64).contains(&near) {
                         on.push((row, near as usize));
                     }
-                    let s = [side(b, c, q), side(c, a, q), side(a, b, q)];
+                    let s = [side(w[0], b, c), side(w[1], c, a), side(w[2], a, b)];
                     if s[0] == s[1] && s[1] == s[2] {
                         let x = match past.signum() {
                             0 => near,
@@ -267,11 +272,10 @@ fn det(a: [i64; 2], b: [i64; 2], q: [i64; 2]) -> i128 {
     m(b[0] - a[0], q[1] - a[1]) - m(b[1] - a[1], q[0] - a[0])
 }
 
-/// The sign of [`det`] with `q` moved to `(q_y + ε, q_z + ε²)`: the terms in ε and ε² decide
-/// where `q` lies on the line through `a` and `b`. Zero only if `a` and `b` project to one
-/// point.
-fn side(a: [i64; 2], b: [i64; 2], q: [i64; 2]) -> i8 {
-    let d = det(a, b, q);
+/// The sign of `d = det(a, b, q)` with `q` moved to `(q_y + ε, q_z + ε²)`: the terms in ε and
+/// ε² decide where `q` lies on the line through `a` and `b`. Zero only if `a` and `b` project
+/// to one point.
+fn side(d: i128, a: [i64; 2], b: [i64; 2]) -> i8 {
     let sign = |v: i128| v.signum() as i8;
     if d != 0 {
         sign(d)
