@@ -153,14 +153,14 @@ impl Crossings {
                         continue;
                     }
                     let x = (0..3)
-                        .map(|k| w[k] as f64 * grid[t[k] as usize][0])
+                        .map(|k| float(w[k]) * grid[t[k] as usize][0])
                         .sum::<f64>()
-                        / area as f64;
+                        / float(area);
                     // Where the crossing lies against the nearest sample: exactly where `x`,
                     // good to some 10⁻⁹ steps, cannot tell.
                     let near = x.round();
                     let past = if (x - near).abs() > 1e-6 {
-                        (x - near).signum() as i128
+                        if x > near { 1 } else { -1 }
                     } else {
                         (0..3)
                             .map(|k| w[k] * i128::from(p[k][0] - near as i64 * ONE))
@@ -254,6 +254,12 @@ fn along(p: [[i64; 3]; 3], q: [i64; 2]) -> Option<std::ops::RangeInclusive<i64>>
         }
     }
     (lo <= hi).then_some(lo..=hi)
+}
+
+/// `v` as `f64`, through `i64` where it fits (nearly always: a triangle's weights are products
+/// of its own sides), which is much cheaper than converting an `i128`.
+fn float(v: i128) -> f64 {
+    i64::try_from(v).map_or(v as f64, |v| v as f64)
 }
 
 /// `⌊v / ONE⌋` for a fixed-point `v`.
