@@ -16,19 +16,20 @@
 //! sample's parity is exact. Most vertices of a Steps 1–3 mesh lie on such rows (a vertex on an
 //! x edge has integer y and z), so the rule is needed, not a corner case.
 //!
-//! **Samples on the surface.** A crossing at the sample's own x counts as behind it: the sample
-//! is taken just past the surface along +x, on the side a point there has. Where a crossing and
-//! a sample are within about 10⁻¹² grid steps the comparison is of rounded numbers; SPEC §1's
-//! clamp keeps the extractor's vertices 1/1024 grid step off every sample.
+//! **Samples on the surface** are on neither side, and never count. SPEC §1's clamp keeps the
+//! extractor's vertices 1/1024 grid step off every sample, and adaptive mode's (P) keeps its
+//! triangles 10⁻³ step off them, but a chord of `--allow-wrong-side`, or a merge of embedded
+//! mode, can pass exactly through samples. Whether a sample lies on a triangle is decided exactly too, faces parallel to x included;
+//! so is where each crossing lies against the samples.
 
 use sc_runtime::{Mesh, Params, Scalar, Volume};
 
 /// The figure's name in every front end's statistics (`--stats-json`, Python's `stats`).
 pub const WRONG_SIDE_SAMPLES: &str = "wrong_side_samples";
 
-/// Fraction bits of the fixed-point grid coordinates: 2⁻²⁰ grid steps, far below any sample's
-/// distance from the extractor's surface, while products of differences stay within `i128`
-/// for grids of up to 2³⁰ samples a side.
+/// Fraction bits of the fixed-point grid coordinates: 2⁻²⁰ grid steps, as fine as an `f32`
+/// position is from 8 grid steps out, while the exact tests stay within `i128` for grids of up
+/// to 2³⁰ samples a side and triangles up to 2²⁰ steps across.
 const FRAC: u32 = 20;
 const ONE: i64 = 1 << FRAC;
 

@@ -165,10 +165,9 @@ pub fn extract<'py>(
 
 /// [`run`], and with `measure` in adaptive mode the samples left on the wrong side of its mesh
 /// (not yet placed in the world), `None` where a border sample is filled. Only adaptive mode
-/// counts them:
-/// the count is one more sweep of the volume, about 1 % of adaptive mode's time but about as
-/// much as the other modes' whole extraction, and Python's stats are always made, never asked
-/// for.
+/// counts them: the count is one more sweep of the volume, under 1 % of adaptive mode's time
+/// but about twice the other modes' whole extraction, and Python's stats are always made, never
+/// asked for.
 fn run_measured<T: Scalar + Element>(
     py: Python<'_>,
     volume: &Bound<'_, PyUntypedArray>,
