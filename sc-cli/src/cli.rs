@@ -321,7 +321,8 @@ pub struct ExtractArgs {
     /// frame (raw, NumPy) always give index × spacing + origin.
     #[arg(long, value_enum, default_value_t = Coordinates::Native)]
     pub space: Coordinates,
-    /// Also write the summary as JSON to this file.
+    /// Also write the summary as JSON to this file, with the samples left on the wrong side of
+    /// the surface (and in adaptive mode its distance to Steps 1–3) measured.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
     /// Write text PLY instead of binary.

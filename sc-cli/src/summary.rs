@@ -3,8 +3,8 @@
 use std::fmt;
 use std::time::Duration;
 
-use sc_io::distance::Distance;
-use sc_io::report;
+use sc_io::surface::Measures;
+use sc_io::{report, separation};
 use sc_runtime::{ErrorBound, ErrorUnits, Mode, Stats};
 use serde_json::{Value, json};
 
@@ -46,11 +46,9 @@ pub struct Summary {
     pub paper_knot: Option<u64>,
     /// With `--check`: how the mesh's edges are shared.
     pub edges: Option<EdgeReport>,
-    /// Adaptive mode: the sampled distance between its surface and Steps 1–3's, in the bound's
-    /// units.
-    pub distance: Option<Distance>,
-    /// Time spent measuring that distance.
-    pub measure: Option<Duration>,
+    /// With `--stats-json`: the samples on the wrong side, and in adaptive mode the sampled
+    /// distance between its surface and Steps 1–3's, in the bound's units.
+    pub measured: Option<Measures>,
 }
 
 /// A mode's name in reports.
@@ -108,20 +106,24 @@ impl Summary {
                 "write": self.write.as_secs_f64(),
             },
         });
-        if let Some(t) = self.measure {
-            j["seconds"]["measure"] = t.as_secs_f64().into();
+        if let Some(m) = self.measured {
+            j["seconds"]["measure"] = m.time.as_secs_f64().into();
         }
         add_counts(&mut j, self.mode, self.max_error, &self.stats);
         if let Some(e) = self.edges {
             j["edges"] = e.to_json();
         }
-        if let Some(d) = self.distance {
+        let measured = self.measured.as_ref();
+        if let Some(d) = measured.and_then(|m| m.distance) {
             j["distance_to_steps123"] = json!({
                 "mean": d.mean,
                 "max": d.max,
                 "samples": d.samples,
                 "units": self.bound_units().name(),
             });
+        }
+        if let Some(n) = measured.and_then(|m| m.wrong_side_samples) {
+            j[separation::WRONG_SIDE_SAMPLES] = n.into();
         }
         j
     }
@@ -193,7 +195,15 @@ impl fmt::Display for Summary {
                 )?;
             }
         }
-        if let Some(d) = self.distance {
+        let measured = self.measured.as_ref();
+        if let Some(n) = measured.and_then(|m| m.wrong_side_samples) {
+            writeln!(
+                f,
+                "  samples on the wrong side of the surface: {}",
+                thousands(n)
+            )?;
+        }
+        if let Some(d) = measured.and_then(|m| m.distance) {
             let units = match self.bound_units() {
                 ErrorUnits::World => "world units",
                 ErrorUnits::Voxels => "voxels",
@@ -236,8 +246,8 @@ impl fmt::Display for Summary {
             self.extract.as_secs_f64(),
             self.write.as_secs_f64()
         )?;
-        if let Some(t) = self.measure {
-            write!(f, ", measure {:.3} s", t.as_secs_f64())?;
+        if let Some(m) = self.measured {
+            write!(f, ", measure {:.3} s", m.time.as_secs_f64())?;
         }
         Ok(())
     }
@@ -246,6 +256,7 @@ impl fmt::Display for Summary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sc_io::distance::Distance;
 
     #[test]
     fn thousands_groups_digits() {
@@ -282,8 +293,7 @@ mod tests {
             write: Duration::from_millis(1),
             paper_knot: None,
             edges: None,
-            distance: None,
-            measure: None,
+            measured: None,
         };
         let text = s.to_string();
         assert!(
@@ -300,17 +310,39 @@ mod tests {
         assert_eq!(j["dims"], serde_json::json!([4, 5, 6]));
         assert_eq!(j["reduction_percent"], 25.0);
         assert!(j.get("distance_to_steps123").is_none() && !text.contains("distance"));
+        assert!(j.get("wrong_side_samples").is_none() && !text.contains("wrong side"));
+
+        // Any mode reports the samples on the wrong side when measured.
+        let embedded = Summary {
+            measured: Some(Measures {
+                distance: None,
+                wrong_side_samples: Some(1234),
+                time: Duration::from_millis(3),
+            }),
+            ..s.clone()
+        };
+        let text = embedded.to_string();
+        assert!(
+            text.contains("samples on the wrong side of the surface: 1,234"),
+            "{text}"
+        );
+        let j = embedded.to_json();
+        assert_eq!(j["wrong_side_samples"], 1234);
+        assert!(j.get("distance_to_steps123").is_none() && !text.contains("distance"));
 
         // Adaptive mode reports its distance to Steps 1–3 in the bound's units.
         let adaptive = Summary {
             mode: Mode::Adaptive,
             max_error: Some(ErrorBound::Voxels(0.5)),
-            distance: Some(Distance {
-                mean: 0.0625,
-                max: 0.375,
-                samples: 1234,
+            measured: Some(Measures {
+                distance: Some(Distance {
+                    mean: 0.0625,
+                    max: 0.375,
+                    samples: 1234,
+                }),
+                wrong_side_samples: Some(0),
+                time: Duration::from_millis(3),
             }),
-            measure: Some(Duration::from_millis(3)),
             ..s
         };
         let text = adaptive.to_string();
@@ -330,5 +362,6 @@ mod tests {
             (Some(1234), Some("voxels"))
         );
         assert_eq!(j["seconds"]["measure"], 0.003);
+        assert_eq!(j["wrong_side_samples"], 0);
     }
 }

@@ -658,5 +658,69 @@ fn adaptive_stats_report_the_distance_to_steps123_within_the_bound() {
         assert!(j["seconds"]["measure"].as_f64().is_some());
     }
     let j = stats(&["--mode", "embedded", "--max-error", "0.3"]);
-    assert!(j.get("distance_to_steps123").is_none() && j["seconds"].get("measure").is_none());
+    assert!(j.get("distance_to_steps123").is_none());
+}
+
+/// With `--stats-json`, every mode reports the samples its surface leaves on the wrong side:
+/// none for Steps 1–3 and adaptive mode, some where adaptive mode allows them; where a sample
+/// on the volume's border is filled the surface is open there, and the figure is left out with
+/// a warning, until `--pad` closes it.
+#[test]
+fn stats_report_the_samples_on_the_wrong_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let stats = |args: &[&str]| torus_stats(dir.path(), args);
+    let wrong = |args: &[&str]| stats(args)["wrong_side_samples"].as_u64();
+    assert_eq!(wrong(&["--mode", "steps123"]), Some(0));
+    assert_eq!(wrong(&["--mode", "adaptive", "--max-error", "1"]), Some(0));
+    let allowed = wrong(&[
+        "--mode",
+        "adaptive",
+        "--max-error",
+        "1",
+        "--allow-wrong-side",
+    ]);
+    assert!(allowed.unwrap() > 0, "{allowed:?}");
+    assert!(wrong(&["--mode", "embedded"]).is_some());
+    assert!(
+        stats(&["--mode", "paper"])["seconds"]["measure"]
+            .as_f64()
+            .is_some()
+    );
+
+    // A 4³ volume whose x = 0 face is filled.
+    let raw = dir.path().join("face.raw");
+    let face: Vec<u8> = (0..64).map(|i| if i % 4 == 0 { 100 } else { 0 }).collect();
+    std::fs::write(&raw, face).unwrap();
+    let json = dir.path().join("face.json");
+    let run = |pad: bool| {
+        let mut cmd = Command::cargo_bin("skelclimb").unwrap();
+        cmd.args([
+            "extract", "-q", "--dims", "4,4,4", "--dtype", "u8", "--iso", "50",
+        ])
+        .args(["--mode", "steps123", "-o"])
+        .arg(dir.path().join("face.ply"))
+        .arg(&raw)
+        .arg("--stats-json")
+        .arg(&json);
+        if pad {
+            cmd.arg("--pad");
+        }
+        let out = cmd.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        (j, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (open, stderr) = run(false);
+    assert!(open.get("wrong_side_samples").is_none(), "{open}");
+    assert!(
+        stderr.contains("wrong_side_samples is not measured"),
+        "{stderr}"
+    );
+    let (padded, stderr) = run(true);
+    assert_eq!(padded["wrong_side_samples"], 0, "{stderr}");
+    assert!(!stderr.contains("not measured"), "{stderr}");
 }

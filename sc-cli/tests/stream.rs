@@ -47,6 +47,7 @@ fn same_either_way(dir: &Path, input: &str, args: &[&str], modes: &[&[&str]]) {
                 cmd.arg("--stream");
             }
             let run = cmd.assert().success();
+            let stderr = String::from_utf8_lossy(&run.get_output().stderr).into_owned();
             let mut json: serde_json::Value =
                 serde_json::from_slice(&std::fs::read(dir.join(&stats)).unwrap()).unwrap();
             json["seconds"] = serde_json::Value::Null;
@@ -55,8 +56,17 @@ fn same_either_way(dir: &Path, input: &str, args: &[&str], modes: &[&[&str]]) {
             let adaptive = mode.contains(&"adaptive");
             assert_eq!(measured.is_some(), adaptive && !stream, "{input} {mode:?}");
             if adaptive && stream {
-                run.stderr(contains("distance_to_steps123 is not measured"));
+                assert!(stderr.contains("distance_to_steps123 is not measured"));
             }
+            // The whole volume's is measured where its border is empty, as a whole run warns.
+            let wrong = json.as_object_mut().unwrap().remove("wrong_side_samples");
+            let why = if stream {
+                "wrong_side_samples is not measured on a streamed volume"
+            } else {
+                "wrong_side_samples is not measured: samples on the volume's border are filled"
+            };
+            assert_eq!(wrong.is_none(), stderr.contains(why), "{input} {mode:?}");
+            assert!(!stream || wrong.is_none(), "{input} {mode:?}");
             outputs.push((std::fs::read(dir.join(&out)).unwrap(), json));
         }
         assert!(

@@ -32,8 +32,8 @@
 //! - [`write`](mod@write): a mesh out, in the format its file name asks for, through an
 //!   [`atomic`] file, whole or not at all; [`mesh_in`]: a mesh read back, for comparisons.
 //! - [`report`]: the counts of an extraction as JSON; [`distance`]: how far apart two meshes
-//!   are; [`progress`]: how long-running work
-//!   tells how far it got.
+//!   are; [`separation`]: which samples a mesh leaves on the wrong side; [`progress`]: how
+//!   long-running work tells how far it got.
 //!
 //! The formats' parsers and writers behind these are private: a format is chosen by its file
 //! name, never named by a caller.
@@ -49,6 +49,7 @@ pub mod mesh_in;
 pub mod progress;
 pub mod read;
 pub mod report;
+pub mod separation;
 pub mod shard;
 mod slabs;
 pub mod space;

@@ -12,6 +12,7 @@ use crate::distance::{self, Distance};
 use crate::error::Result;
 use crate::progress::{Progress, Silent};
 use crate::read::stream::Stream;
+use crate::separation;
 use crate::shard::{MANIFEST_NAME, Manifest, ShardEntry, blocks, write_shard};
 use crate::slabs::stream_blocks;
 use crate::space::{Coordinates, World};
@@ -82,54 +83,89 @@ pub fn extract(grid: &Grid, request: &Request, progress: &dyn Progress) -> Resul
     Ok(extract_measured(grid, request, false, progress)?.0)
 }
 
-/// [`extract`], and in adaptive mode with `measure` also the mesh's sampled symmetric distance
-/// to the Steps 1–3 surface of the same grid, in the units of the error bound it holds (world
-/// units, or grid steps for a bound in voxels), sampled every quarter grid step: what the bound
-/// promises, measured; with the time measuring took. `None` in the other modes, whose bound is
-/// not a distance between surfaces.
+/// What [`extract_measured`] measures of a mesh beside it, and how long measuring took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measures {
+    /// Adaptive mode: the mesh's sampled symmetric distance to the Steps 1–3 surface of the
+    /// same grid, in the units of the error bound it holds (world units, or grid steps for a
+    /// bound in voxels), sampled every quarter grid step: what the bound promises, measured.
+    /// `None` in the other modes, whose bound is not a distance between surfaces.
+    pub distance: Option<Distance>,
+    /// The samples on the wrong side of the mesh ([`separation`]), in every mode: adaptive mode
+    /// keeps it 0 unless wrong sides are allowed, Steps 1–3 always does, and embedded and paper
+    /// modes' merges can move samples across. `None` where a sample on the grid's border is
+    /// filled: the surface is open there.
+    pub wrong_side_samples: Option<u64>,
+    /// The time measuring took.
+    pub time: Duration,
+}
+
+/// [`extract`], and with `measure` also the figures of [`Measures`].
 pub fn extract_measured(
     grid: &Grid,
     request: &Request,
     measure: bool,
     progress: &dyn Progress,
-) -> Result<(Mesh, Option<(Distance, Duration)>)> {
+) -> Result<(Mesh, Option<Measures>)> {
     let world = world(grid, request);
     let params = params(grid, request, &world);
     progress.phase("meshing", grid.dims[2].saturating_sub(1) as u64);
     let mut mesh =
         with_samples!(&grid.samples, v => run(v, grid.dims, &params, request.threads, progress))?;
     let mut measured = None;
-    if measure && params.mode == Mode::Adaptive {
-        let steps123 = Params {
-            mode: Mode::Steps123,
-            normals: false,
-            max_error: None,
-            max_box: None,
-            allow_wrong_side: false,
-            ..params
-        };
+    if measure {
         progress.phase("measuring", 1);
         let clock = Instant::now();
-        let reference = with_samples!(&grid.samples, v => run(v, grid.dims, &steps123, request.threads, &Silent))?;
         // Measured before any placement, where grid steps are `spacing` apart along each axis.
-        let least = params.spacing.iter().copied().fold(f64::INFINITY, f64::min);
-        let (scale, step) = match request.max_error {
-            Some(ErrorBound::Voxels(_)) => (params.spacing.map(|s| 1.0 / s), 0.25),
-            _ => ([1.0; 3], 0.25 * least),
+        let wrong_side_samples = with_samples!(&grid.samples, v => {
+            separation::wrong_side_samples(&Volume::new(v, grid.dims)?, &params, &mesh)
+        });
+        let distance = if params.mode == Mode::Adaptive {
+            Some(distance_to_steps123(grid, &params, request, &mesh)?)
+        } else {
+            None
         };
-        let d = distance::symmetric(
-            (&mesh.positions, &mesh.triangles),
-            (&reference.positions, &reference.triangles),
-            scale,
-            step,
-        );
-        measured = Some((d, clock.elapsed()));
+        measured = Some(Measures {
+            distance,
+            wrong_side_samples,
+            time: clock.elapsed(),
+        });
         progress.inc(1);
     }
     if !world.is_translation() {
         world.place(&mut mesh);
     }
     Ok((mesh, measured))
+}
+
+/// [`Measures::distance`] of an adaptive mesh not yet placed in the world.
+fn distance_to_steps123(
+    grid: &Grid,
+    params: &Params,
+    request: &Request,
+    mesh: &Mesh,
+) -> Result<Distance> {
+    let steps123 = Params {
+        mode: Mode::Steps123,
+        normals: false,
+        max_error: None,
+        max_box: None,
+        allow_wrong_side: false,
+        ..*params
+    };
+    let reference =
+        with_samples!(&grid.samples, v => run(v, grid.dims, &steps123, request.threads, &Silent))?;
+    let least = params.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+    let (scale, step) = match request.max_error {
+        Some(ErrorBound::Voxels(_)) => (params.spacing.map(|s| 1.0 / s), 0.25),
+        _ => ([1.0; 3], 0.25 * least),
+    };
+    Ok(distance::symmetric(
+        (&mesh.positions, &mesh.triangles),
+        (&reference.positions, &reference.triangles),
+        scale,
+        step,
+    ))
 }
 
 /// Extracts the surface of a volume read slab by slab: the same mesh as [`extract`] of the

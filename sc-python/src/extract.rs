@@ -4,6 +4,7 @@ use numpy::{Element, PyUntypedArray};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use sc_io::separation;
 use sc_io::space::{Space, World};
 use sc_runtime::{ErrorBound, Figure, Mesh, Mode, Params, Scalar, Stats, Volume, extract_par};
 
@@ -132,12 +133,16 @@ pub fn extract<'py>(
         ..params(level, spacing, origin, mode, normals, max_error)?
     };
     let dims = convert::dims(volume, "volume")?;
-    let mut mesh =
-        with_element!(py, volume, "volume", T => run::<T>(py, volume, dims, &params, threads))?;
+    let (mut mesh, wrong_side) = with_element!(py, volume, "volume", T => {
+        run_measured::<T>(py, volume, dims, &params, threads, true)
+    })?;
     if !world.is_translation() {
         py.detach(|| world.place(&mut mesh));
     }
     let stats = stats(py, &mesh.stats, mode, level, dims, world.space)?;
+    if params.mode == Mode::Adaptive {
+        stats.set_item(separation::WRONG_SIDE_SAMPLES, wrong_side)?;
+    }
     let Mesh {
         positions,
         normals: vertex_normals,
@@ -158,6 +163,34 @@ pub fn extract<'py>(
         .into_pyobject(py)
 }
 
+/// [`run`], and with `measure` in adaptive mode the samples left on the wrong side of its mesh
+/// (not yet placed in the world), `None` where a border sample is filled. Only adaptive mode
+/// counts them: the count is one more sweep of the volume, under 1 % of adaptive mode's time
+/// but about twice the other modes' whole extraction, and Python's stats are always made, never
+/// asked for.
+fn run_measured<T: Scalar + Element>(
+    py: Python<'_>,
+    volume: &Bound<'_, PyUntypedArray>,
+    dims: [usize; 3],
+    params: &Params,
+    threads: usize,
+    measure: bool,
+) -> PyResult<(Mesh, Option<u64>)> {
+    let samples = convert::samples::<T>(volume, "volume")?;
+    let data = samples
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("volume: the array is not contiguous"))?;
+    let volume = Volume::new(data, dims).map_err(errors::runtime)?;
+    py.detach(|| {
+        let mesh = extract_par(&volume, params, threads, &|_| {})?;
+        let wrong = (measure && params.mode == Mode::Adaptive)
+            .then(|| separation::wrong_side_samples(&volume, params, &mesh))
+            .flatten();
+        Ok((mesh, wrong))
+    })
+    .map_err(errors::runtime)
+}
+
 pub(crate) fn run<T: Scalar + Element>(
     py: Python<'_>,
     volume: &Bound<'_, PyUntypedArray>,
@@ -165,13 +198,7 @@ pub(crate) fn run<T: Scalar + Element>(
     params: &Params,
     threads: usize,
 ) -> PyResult<Mesh> {
-    let samples = convert::samples::<T>(volume, "volume")?;
-    let data = samples
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("volume: the array is not contiguous"))?;
-    let volume = Volume::new(data, dims).map_err(errors::runtime)?;
-    py.detach(|| extract_par(&volume, params, threads, &|_| {}))
-        .map_err(errors::runtime)
+    Ok(run_measured::<T>(py, volume, dims, params, threads, false)?.0)
 }
 
 /// The figures the CLI's `--stats-json` reports, as a dict, with the world convention of the

@@ -64,3 +64,22 @@ def test_allowing_wrong_side_never_adds_triangles():
 def test_bad_options_are_refused_by_name(kwargs, error, words):
     with pytest.raises(error, match=words):
         skelclimb.extract(_ball(), 0.0, **kwargs)
+
+
+def test_stats_count_the_samples_on_the_wrong_side():
+    v = _ball()
+    options = dict(mode="adaptive", max_error=1, error_units="voxels")
+    kept = skelclimb.extract(v, 0.0, **options)
+    allowed = skelclimb.extract(v, 0.0, allow_wrong_side=True, **options)
+    assert kept.stats["wrong_side_samples"] == 0
+    assert allowed.stats["wrong_side_samples"] > 0
+    # Counted where the extractor placed the mesh, before any other world map.
+    swap = np.array([[0, 2, 0, 10], [2, 0, 0, 0], [0, 0, 2, 0], [0, 0, 0, 1]])
+    placed = skelclimb.extract(v, 0.0, allow_wrong_side=True, affine=swap, **options)
+    assert placed.stats["wrong_side_samples"] == allowed.stats["wrong_side_samples"]
+    # A filled border sample opens the surface: not counted, until `pad` closes it.
+    v[0, 0, 0] = 1
+    assert skelclimb.extract(v, 0.0, **options).stats["wrong_side_samples"] is None
+    assert skelclimb.extract(v, 0.0, pad=True, **options).stats["wrong_side_samples"] == 0
+    # The other modes do not count them.
+    assert "wrong_side_samples" not in skelclimb.extract(v, 0.0, mode="steps123").stats

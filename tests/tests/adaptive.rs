@@ -7,17 +7,18 @@
 //!   triangle that differs, against every triangle of the other mesh;
 //! - no sample on the wrong side: the two meshes differ by closed surfaces (each box's new patch
 //!   against its old one), and a sample changes side iff its winding number about them is ±1,
-//!   counted exactly by the crossings of a ray along x (solid angles where the sample lies on
-//!   the surface).
+//!   counted exactly by the crossings of a ray along x (a sample on the surface is on neither
+//!   side), and `sc_io::separation`'s count of them, which `--stats-json` reports, agrees.
 
 use std::collections::{HashMap, HashSet};
 
+use sc_io::separation;
 use sc_runtime::labels::{LabelParams, extract_labels};
 use sc_runtime::{
     Error, ErrorBound, Mesh, Mode, Params, Volume, block_samples, demo, extract, extract_par,
 };
 use sc_tests::checks::{assert_closed_manifold, assert_no_self_intersections};
-use sc_tests::geometry::{RowWinding, point_triangle_distance, solid_angle};
+use sc_tests::geometry::{RowWinding, point_triangle_distance};
 use sc_tests::volumes::{
     self, Sample, Vol, brainsmall_crop, integer_noise, itk_t1_crop, stent_crop,
 };
@@ -217,16 +218,9 @@ fn wrong_side<T: Sample>(vol: &Vol<T>, mesh: &Mesh, reference: &Mesh) -> usize {
             let row = RowWinding::new(py, pz, near.iter().map(|&i| &diff[i]));
             for x in a[0]..=b[0] {
                 let p = vol.world([x, *y, *z]);
-                // On the surface (for the moved line): the solid angles decide, as a point on
-                // a triangle counts half.
-                let w = row.at(p).map_or_else(
-                    || {
-                        tris.iter().map(|&i| solid_angle(p, diff[i])).sum::<f64>()
-                            / (4.0 * std::f64::consts::PI)
-                    },
-                    f64::from,
-                );
-                if w.abs() > 0.5 {
+                // On the surface (for the moved line): on neither side, so not on the wrong one
+                // (the Steps 1–3 surface passes through no sample).
+                if row.at(p).is_some_and(|w| w != 0) {
                     wrong += 1;
                 }
             }
@@ -304,6 +298,12 @@ fn holds_allowing<T: Sample>(
         "{what}: Steps 1–3 → adaptive {back}"
     );
     let wrong = wrong_side(vol, &mesh, &steps123);
+    // The figure `--stats-json` reports, by crossings of the mesh alone, agrees.
+    assert_eq!(
+        separation::wrong_side_samples(&volume, &params, &mesh),
+        Some(wrong as u64),
+        "{what}: wrong_side_samples"
+    );
     println!(
         "{what}: Steps 1–3 {} triangles, adaptive {} ({:.2}×), {} vertices of {}; distance {:.3} / {:.3} voxel; {wrong} samples on the wrong side",
         steps123.triangles.len(),

@@ -53,22 +53,35 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
     let clock = Instant::now();
     let request = request(args, iso);
     let world = surface::world(volume.grid(), &request);
-    let (mesh, distance) = match &mut volume {
+    let measure = args.stats_json.is_some();
+    let (mesh, measured) = match &mut volume {
         Volume::Whole(grid) => {
-            surface::extract_measured(grid, &request, args.stats_json.is_some(), &progress)?
+            let (mesh, measured) = surface::extract_measured(grid, &request, measure, &progress)?;
+            if measured.is_some_and(|m| m.wrong_side_samples.is_none()) {
+                warn(
+                    "wrong_side_samples is not measured: samples on the volume's border are \
+                     filled, so the surface is open there (--pad closes it)",
+                );
+            }
+            (mesh, measured)
         }
         Volume::Streamed(stream) => {
-            if args.mode == Mode::Adaptive && args.stats_json.is_some() {
+            if measure && args.mode == Mode::Adaptive {
                 warn(
                     "distance_to_steps123 is not measured on a streamed volume: it needs the \
                      whole volume's Steps 1–3 mesh",
                 );
             }
+            if measure {
+                warn(
+                    "wrong_side_samples is not measured on a streamed volume: it needs the \
+                     whole volume",
+                );
+            }
             (surface::extract_stream(stream, &request, &progress)?, None)
         }
     };
-    let measure_time = distance.map(|(_, t)| t);
-    let extract_time = clock.elapsed() - measure_time.unwrap_or_default();
+    let extract_time = clock.elapsed() - measured.map(|m| m.time).unwrap_or_default();
     for warning in &volume.grid().warnings {
         warn(warning);
     }
@@ -104,8 +117,7 @@ pub fn run(args: &ExtractArgs, quiet: bool) -> Result<()> {
         write: clock.elapsed(),
         paper_knot,
         edges: args.check.then(|| EdgeReport::of(&mesh.triangles)),
-        distance: distance.map(|(d, _)| d),
-        measure: measure_time,
+        measured,
     };
     super::commit_with_report(mesh_filled, stats_file, || summary.to_json())?;
     if !quiet {

@@ -66,7 +66,10 @@ class Mesh:
         ``bounded`` grey edges (``bounded``: blocked by ``max_error`` alone),
         ``reduction_percent``, ``mode``, ``iso``, ``dims`` (``[nx, ny, nz]``), and ``space``: the
         world convention of the vertices, ``"RAS"`` or ``"LPS"``, or None (index × spacing +
-        origin, or an affine given without a ``space``).
+        origin, or an affine given without a ``space``). From :func:`extract` in adaptive mode,
+        also ``wrong_side_samples``: the samples on the wrong side of the surface (0 unless
+        ``allow_wrong_side``), or None where a sample on the volume's border is filled (the
+        surface is open there; ``pad`` closes it).
     """
 
     __slots__ = ("vertices", "faces", "normals", "stats")
