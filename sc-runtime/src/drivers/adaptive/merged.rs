@@ -10,7 +10,7 @@
 
 use alloc::vec::Vec;
 
-use super::record::Recorded;
+use super::record::{MERGED, Recorded};
 use crate::kernel::adaptive::Tolerance;
 use crate::kernel::adaptive::checks::{scaled, within};
 
@@ -22,11 +22,35 @@ fn canonical(t: [u32; 3], edges: &[u64]) -> [u64; 3] {
 }
 
 /// One merge read back from the sweeps: Steps 1–3's fan around the removed vertex and
-/// embedded mode's triangles on its ring.
+/// embedded mode's triangles on its ring. Held in place, not in lists of their own: a scan has
+/// tens of thousands of merges, and a whole one has four and two.
 #[derive(Default)]
 struct Merge {
-    fan: Vec<usize>,
-    new: Vec<[u64; 3]>,
+    fan: [usize; 4],
+    fans: u8,
+    new: [[u64; 3]; 2],
+    news: u8,
+}
+
+impl Merge {
+    fn push_fan(&mut self, triangle: usize) {
+        if let Some(slot) = self.fan.get_mut(usize::from(self.fans)) {
+            *slot = triangle;
+        }
+        self.fans = self.fans.saturating_add(1);
+    }
+
+    fn push_new(&mut self, triangle: [u64; 3]) {
+        if let Some(slot) = self.new.get_mut(usize::from(self.news)) {
+            *slot = triangle;
+        }
+        self.news = self.news.saturating_add(1);
+    }
+
+    /// A fan of four and two triangles replacing it, as Step 4 makes every merge.
+    fn whole(&self) -> bool {
+        self.fans == 4 && self.news == 2
+    }
 }
 
 /// Triangles with the key of the cube that owns each, and the owner of each merge kept.
@@ -54,39 +78,63 @@ pub(super) fn unit_triangles(
     in_box: impl Fn(u64) -> bool,
     tolerance: &Tolerance,
 ) -> Units {
-    let sorted = |mut v: Vec<u64>| {
-        v.sort_unstable();
-        v.dedup();
-        v
-    };
-    let used = |tris: &[[u32; 3]], edges: &[u64]| {
-        sorted(tris.iter().flatten().map(|&v| edges[v as usize]).collect())
-    };
-    let kept_vertices = used(&merged.mesh.triangles, &merged.edges);
-    let old: Vec<u64> = used(triangles, &steps.edges)
-        .into_iter()
-        .filter(|k| kept_vertices.binary_search(k).is_err())
-        .collect();
+    // The Steps 1–3 vertices embedded mode merged away: used by Steps 1–3's triangles and not
+    // by embedded mode's, one merge each, in the order of their edges.
+    let mut kept = alloc::vec![false; steps.edges.len()];
+    for t in &merged.mesh.triangles {
+        for &v in t {
+            kept[vertex_id(merged.edges[v as usize]) as usize] = true;
+        }
+    }
+    let mut old: Vec<u32> = Vec::new();
+    for t in triangles {
+        for &v in t {
+            if !kept[v as usize] {
+                // Marked once listed, so each is listed once.
+                kept[v as usize] = true;
+                old.push(v);
+            }
+        }
+    }
+    old.sort_unstable_by_key(|&v| steps.edges[v as usize]);
+    let mut merge_of = alloc::vec![u32::MAX; steps.edges.len()];
+    for (m, &v) in old.iter().enumerate() {
+        merge_of[v as usize] = m as u32;
+    }
+    drop(kept);
     let mut merges: Vec<Merge> = (0..old.len()).map(|_| Merge::default()).collect();
-    // Each ring vertex with the merges whose ring holds it.
-    let mut ring: Vec<(u64, u32)> = Vec::new();
-    for (i, &t) in triangles.iter().enumerate() {
-        let k = canonical(t, &steps.edges);
-        for (c, key) in k.iter().enumerate() {
-            if let Ok(m) = old.binary_search(key) {
-                merges[m].fan.push(i);
-                ring.extend([k[(c + 1) % 3], k[(c + 2) % 3]].map(|r| (r, m as u32)));
+    let mut corners = 0;
+    for (i, t) in triangles.iter().enumerate() {
+        for &v in t {
+            let m = merge_of[v as usize];
+            if m != u32::MAX {
+                merges[m as usize].push_fan(i);
+                corners += 2;
+            }
+        }
+    }
+    drop(merge_of);
+    // Each ring vertex (by key) with the merges whose ring holds it: the fans' other corners.
+    let mut ring: Vec<(u64, u32)> = Vec::with_capacity(corners);
+    for (m, (merge, &v)) in merges.iter().zip(&old).enumerate() {
+        let key = steps.edges[v as usize];
+        for &i in merge.fan.iter().take(usize::from(merge.fans)) {
+            for &r in &triangles[i] {
+                let r = steps.edges[r as usize];
+                if r != key {
+                    ring.push((r, m as u32));
+                }
             }
         }
     }
     ring.sort_unstable();
     ring.dedup();
-    let before = sorted_triangles(triangles, &steps.edges);
-    for &t in &merged.mesh.triangles {
-        let k = canonical(t, &merged.edges);
-        if before.binary_search(&k).is_ok() {
+    // Embedded mode's merged pairs, each given to the merge whose ring holds its corners.
+    for (&t, &cube) in merged.mesh.triangles.iter().zip(&merged.cubes) {
+        if cube & MERGED == 0 {
             continue;
         }
+        let k = canonical(t, &merged.edges);
         let on_ring = |m: u32| k.iter().all(|&v| ring.binary_search(&(v, m)).is_ok());
         let from = ring.partition_point(|&(v, _)| v < k[0]);
         if let Some(&(_, m)) = ring[from..]
@@ -94,14 +142,14 @@ pub(super) fn unit_triangles(
             .take_while(|&&(v, _)| v == k[0])
             .find(|&&(_, m)| on_ring(m))
         {
-            merges[m as usize].new.push(k);
+            merges[m as usize].push_new(k);
         }
     }
     let mut dropped = alloc::vec![false; triangles.len()];
     let mut out = Vec::new();
     let mut kept = Vec::new();
     for m in &merges {
-        let whole = m.fan.len() == 4 && m.new.len() == 2;
+        let whole = m.whole();
         if whole
             && m.fan.iter().all(|&i| !in_box(steps.cubes[i]))
             && within_each_other(m, triangles, steps, &place, tolerance)
@@ -132,13 +180,6 @@ pub(super) fn unit_triangles(
         triangles: all,
         merges: kept,
     }
-}
-
-/// The triangles as canonical edge-key triples, sorted.
-fn sorted_triangles(triangles: &[[u32; 3]], edges: &[u64]) -> Vec<[u64; 3]> {
-    let mut v: Vec<[u64; 3]> = triangles.iter().map(|&t| canonical(t, edges)).collect();
-    v.sort_unstable();
-    v
 }
 
 /// (E) for a merge: its two triangles and its fan within the bound of each other, both ways.

@@ -6,6 +6,10 @@ use alloc::vec::Vec;
 use crate::mesh::grow;
 use crate::{Mesh, Sink};
 
+/// Marks, in [`Recorded::cubes`], a triangle of a pair Step 4 merged: what adaptive mode keeps
+/// of embedded mode's sweep.
+pub const MERGED: u64 = 1 << 63;
+
 /// A mesh being swept, and each vertex's edge key and each triangle's cube key
 /// (`x + nx · (y + ny · z)`; an edge's key is `3 ·` its lower end's key `+` its axis).
 pub(super) struct Recorded {
@@ -93,5 +97,14 @@ impl Sink for Recorded {
     fn cube_triangle(&mut self, cube: [usize; 3], triangle: [u32; 3]) {
         self.cubes.push(self.point_key(cube));
         self.mesh.triangle(triangle);
+    }
+
+    /// Only merged pairs come this way (the sweep's other triangles come by
+    /// [`Sink::cube_triangle`]), so they are marked [`MERGED`].
+    fn cube_triangle_if(&mut self, cube: [usize; 3], triangle: [u32; 3], keep: bool) {
+        if keep {
+            self.cubes.push(self.point_key(cube) | MERGED);
+            self.mesh.triangle(triangle);
+        }
     }
 }
