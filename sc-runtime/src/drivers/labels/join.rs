@@ -25,11 +25,13 @@ pub(super) fn join<L: Label>(
         top,
         ..
     } = first;
+    // Each list grows once to its joined length, rather than doubling as the copies come.
     let rest: Vec<Piece<L>> = pieces.collect();
     let more = |f: &dyn Fn(&Piece<L>) -> usize| rest.iter().map(f).sum::<usize>();
     atlas.positions.reserve(more(&|p| p.atlas.positions.len()));
     atlas.triangles.reserve(more(&|p| p.atlas.triangles.len()));
     atlas.pairs.reserve(more(&|p| p.atlas.triangles.len()));
+    ears.reserve(more(&|p| p.ears.len()));
     edges.reserve(more(&|p| p.edges.len()));
     // The previous piece's top plane, in the joined numbering (plus one, 0 for none).
     let mut shared = top;
