@@ -49,54 +49,91 @@ fn corners(positions: &[[f32; 3]], t: [u32; 3]) -> [P; 3] {
     t.map(|i| positions[i as usize].map(f64::from))
 }
 
-/// Triangles of `mesh` bucketed by the cells of side `h` their boxes, grown by `reach`, touch.
+/// Triangles of `mesh` bucketed by the cells of side `h` their boxes, grown by `reach`, touch:
+/// a dense grid of cells over the grown boxes, `lo` its first cell.
 struct Buckets {
     tris: Vec<[P; 3]>,
     h: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    lo: [i64; 3],
+    n: [usize; 3],
+    cells: Vec<Vec<u32>>,
 }
 
 impl Buckets {
     fn new(mesh: &Mesh, h: f64, reach: f64) -> Self {
-        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
         let tris: Vec<[P; 3]> = mesh
             .triangles
             .iter()
             .map(|&t| corners(&mesh.positions, t))
             .collect();
-        for (i, &c) in tris.iter().enumerate() {
-            let lo: [i64; 3] = std::array::from_fn(|d| {
-                ((c.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min) - reach) / h).floor() as i64
-            });
-            let hi: [i64; 3] = std::array::from_fn(|d| {
-                ((c.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max) + reach) / h).floor()
-                    as i64
-            });
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        cells.entry([x, y, z]).or_default().push(i as u32);
+        // Each triangle's cells, from its box grown by the reach.
+        let span = |c: &[P; 3]| -> [[i64; 3]; 2] {
+            let cell = |v: f64| (v / h).floor() as i64;
+            let least = |d: usize| c.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min);
+            let most = |d: usize| c.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max);
+            [
+                std::array::from_fn(|d| cell(least(d) - reach)),
+                std::array::from_fn(|d| cell(most(d) + reach)),
+            ]
+        };
+        let spans: Vec<[[i64; 3]; 2]> = tris.iter().map(span).collect();
+        let lo: [i64; 3] =
+            std::array::from_fn(|d| spans.iter().map(|s| s[0][d]).min().unwrap_or(0));
+        let hi: [i64; 3] =
+            std::array::from_fn(|d| spans.iter().map(|s| s[1][d]).max().unwrap_or(-1));
+        let n: [usize; 3] = std::array::from_fn(|d| (hi[d] - lo[d] + 1).max(0) as usize);
+        let mut cells = vec![Vec::new(); n.iter().product()];
+        for (i, [a, b]) in spans.iter().enumerate() {
+            for z in a[2]..=b[2] {
+                for y in a[1]..=b[1] {
+                    for x in a[0]..=b[0] {
+                        let at = [x, y, z];
+                        let k = (0..3)
+                            .rev()
+                            .fold(0, |k, d| k * n[d] + (at[d] - lo[d]) as usize);
+                        cells[k].push(i as u32);
                     }
                 }
             }
         }
-        Buckets { tris, h, cells }
+        Buckets {
+            tris,
+            h,
+            lo,
+            n,
+            cells,
+        }
     }
 
-    /// The distance from `p` to the mesh, if some triangle is within the reach.
-    fn distance(&self, p: P) -> f64 {
-        let cell = p.map(|c| (c / self.h).floor() as i64);
-        self.cells.get(&cell).map_or(f64::INFINITY, |ts| {
-            ts.iter()
-                .map(|&i| point_triangle_distance(p, self.tris[i as usize]))
-                .fold(f64::INFINITY, f64::min)
-        })
+    /// The distance from `p` to the mesh, if some triangle is within the reach and it exceeds
+    /// `floor`; otherwise some value at most `floor`, found as soon as a triangle that near is:
+    /// the largest of such distances over many points is their largest distance.
+    fn distance_above(&self, p: P, floor: f64) -> f64 {
+        let at: [i64; 3] = p.map(|c| (c / self.h).floor() as i64);
+        let inside = (0..3).all(|d| at[d] >= self.lo[d] && at[d] - self.lo[d] < self.n[d] as i64);
+        let cell: &[u32] = if inside {
+            let k = (0..3)
+                .rev()
+                .fold(0, |k, d| k * self.n[d] + (at[d] - self.lo[d]) as usize);
+            &self.cells[k]
+        } else {
+            &[]
+        };
+        let mut least = f64::INFINITY;
+        for &i in cell {
+            least = least.min(point_triangle_distance(p, self.tris[i as usize]));
+            if least <= floor {
+                break;
+            }
+        }
+        least
     }
 }
 
 /// The largest distance from a lattice of `n` steps per side on each triangle of `from` that is
-/// not in `to` (those in both are at distance 0) to the mesh `to`.
-fn one_way(from: &Mesh, to: &Mesh, reach: f64, n: usize) -> f64 {
+/// not in `to` (those in both are at distance 0) to the mesh `to`, or some value at most
+/// `floor` when that is larger: no point's distance is sought below it.
+fn one_way(from: &Mesh, to: &Mesh, reach: f64, n: usize, floor: f64) -> f64 {
     let shared: HashSet<[[u32; 3]; 3]> = to
         .triangles
         .iter()
@@ -114,7 +151,7 @@ fn one_way(from: &Mesh, to: &Mesh, reach: f64, n: usize) -> f64 {
             for j in 0..=n - i {
                 let (s, r) = (i as f64 / n as f64, j as f64 / n as f64);
                 let p: P = std::array::from_fn(|d| a[d] + s * (b[d] - a[d]) + r * (c[d] - a[d]));
-                worst = worst.max(buckets.distance(p));
+                worst = worst.max(buckets.distance_above(p, worst.max(floor)));
             }
         }
     }
@@ -232,7 +269,37 @@ fn wrong_side<T: Sample>(vol: &Vol<T>, mesh: &Mesh, reference: &Mesh) -> usize {
 /// Every check on one padded volume at one bound (in grid steps); returns the triangle counts
 /// (Steps 1–3, adaptive).
 fn holds<T: Sample>(vol: &Vol<T>, bound: f64, what: &str) -> (usize, usize) {
-    let (s123, ours, wrong) = holds_allowing(vol, bound, false, what);
+    holds_with(vol, bound, FULL, what)
+}
+
+/// How closely [`holds_allowing`] looks: whether it checks the mesh is the same on threads, the
+/// steps per side of the lattice on which it samples each triangle's distance, and whether it
+/// finds the largest distance (printed) or only that none exceeds the bound.
+#[derive(Clone, Copy)]
+struct Effort {
+    threads: bool,
+    lattice: usize,
+    exact_distance: bool,
+}
+
+/// For the volumes of the tests below but the exhaustive one.
+const FULL: Effort = Effort {
+    threads: true,
+    lattice: 6,
+    exact_distance: true,
+};
+
+/// For the exhaustive test's 8,820 volumes of a few hundred triangles each, whose triangles
+/// are at most a box of two cubes across: corners, side midpoints and thirds, and centroids.
+const LIGHT: Effort = Effort {
+    threads: false,
+    lattice: 3,
+    exact_distance: false,
+};
+
+/// [`holds`], looking as closely as `effort` says.
+fn holds_with<T: Sample>(vol: &Vol<T>, bound: f64, effort: Effort, what: &str) -> (usize, usize) {
+    let (s123, ours, wrong) = holds_allowing(vol, bound, false, effort, what);
     assert_eq!(wrong, 0, "{what} at {bound} voxel");
     (s123, ours)
 }
@@ -243,6 +310,7 @@ fn holds_allowing<T: Sample>(
     vol: &Vol<T>,
     bound: f64,
     allow_wrong_side: bool,
+    effort: Effort,
     what: &str,
 ) -> (usize, usize, usize) {
     let steps123 = vol.extract(Mode::Steps123);
@@ -254,11 +322,13 @@ fn holds_allowing<T: Sample>(
     let what = format!("{what} at {bound} voxel, allow_wrong_side {allow_wrong_side}");
     // Its boxes shared out over threads, in ranges of some 64 boxes: the same mesh.
     let volume = Volume::new(&vol.data, vol.dims).unwrap();
-    assert_eq!(
-        extract_par(&volume, &params, 3, &|_| {}).unwrap(),
-        mesh,
-        "{what}: 3 threads"
-    );
+    if effort.threads {
+        assert_eq!(
+            extract_par(&volume, &params, 3, &|_| {}).unwrap(),
+            mesh,
+            "{what}: 3 threads"
+        );
+    }
     assert_eq!(mesh.stats.t13, steps123.triangles.len() as u64, "{what}");
     assert_eq!(mesh.stats.triangles, mesh.triangles.len() as u64, "{what}");
     assert_eq!(mesh.stats.vertices, mesh.positions.len() as u64, "{what}");
@@ -287,8 +357,13 @@ fn holds_allowing<T: Sample>(
         "{what}: isotropic volumes only"
     );
     let tol = 1e-4 * least;
-    let there = one_way(&mesh, &steps123, bound_world, 6);
-    let back = one_way(&steps123, &mesh, bound_world, 6);
+    let floor = if effort.exact_distance {
+        0.0
+    } else {
+        bound_world
+    };
+    let there = one_way(&mesh, &steps123, bound_world, effort.lattice, floor);
+    let back = one_way(&steps123, &mesh, bound_world, effort.lattice, floor);
     assert!(
         there <= bound_world + tol,
         "{what}: adaptive → Steps 1–3 {there}"
@@ -304,16 +379,18 @@ fn holds_allowing<T: Sample>(
         Some(wrong as u64),
         "{what}: wrong_side_samples"
     );
-    println!(
-        "{what}: Steps 1–3 {} triangles, adaptive {} ({:.2}×), {} vertices of {}; distance {:.3} / {:.3} voxel; {wrong} samples on the wrong side",
-        steps123.triangles.len(),
-        mesh.triangles.len(),
-        steps123.triangles.len() as f64 / mesh.triangles.len().max(1) as f64,
-        mesh.positions.len(),
-        steps123.positions.len(),
-        there / least,
-        back / least,
-    );
+    if effort.exact_distance {
+        println!(
+            "{what}: Steps 1–3 {} triangles, adaptive {} ({:.2}×), {} vertices of {}; distance {:.3} / {:.3} voxel; {wrong} samples on the wrong side",
+            steps123.triangles.len(),
+            mesh.triangles.len(),
+            steps123.triangles.len() as f64 / mesh.triangles.len().max(1) as f64,
+            mesh.positions.len(),
+            steps123.positions.len(),
+            there / least,
+            back / least,
+        );
+    }
     (steps123.triangles.len(), mesh.triangles.len(), wrong)
 }
 
@@ -325,12 +402,12 @@ fn allowing_wrong_side_holds_the_other_checks() {
         (demo::torus(48), "torus 48³"),
     ] {
         let vol = volumes::demo(v);
-        let (_, kept, _) = holds_allowing(&vol, 1.0, false, what);
-        let (_, allowed, _) = holds_allowing(&vol, 1.0, true, what);
+        let (_, kept, _) = holds_allowing(&vol, 1.0, false, FULL, what);
+        let (_, allowed, _) = holds_allowing(&vol, 1.0, true, FULL, what);
         assert!(allowed < kept, "{what}: {allowed} ≥ {kept}");
     }
     let b = brainsmall_crop().padded(0);
-    holds_allowing(&b, 0.5, true, "brainsmall crop");
+    holds_allowing(&b, 0.5, true, FULL, "brainsmall crop");
 }
 
 #[test]
@@ -543,4 +620,98 @@ fn larger_boxes_grow() {
         small.triangles.len(),
         large.triangles.len()
     );
+}
+
+/// The down-sets of the 3×3×3 sample block (filled at a sample means filled at every sample
+/// below it on all three axes): the plane partitions in a 3×3×3 box, 980 of them, as heights
+/// `h[x][y]` that never grow along x or y, filled iff `z < h[x][y]`.
+fn down_sets() -> Vec<[[u8; 3]; 3]> {
+    (0..4u32.pow(9))
+        .map(|code| {
+            std::array::from_fn(|x| std::array::from_fn(|y| (code >> (2 * (3 * x + y)) & 3) as u8))
+        })
+        .filter(|h: &[[u8; 3]; 3]| {
+            (0..3).all(|x| {
+                (0..3).all(|y| {
+                    (x == 0 || h[x][y] <= h[x - 1][y]) && (y == 0 || h[x][y] <= h[x][y - 1])
+                })
+            })
+        })
+        .collect()
+}
+
+/// Every down-set sign pattern of a box of two cubes (docs/adaptive.md §11), in each of its 8
+/// orientations with crossings at the midpoints, and in one of them (in turn) with crossings at
+/// random places out to the clamp's limits: 8,820 volumes. Each pattern is a tile of two cubes
+/// on the boxes' lattice, with its mirror images below it along each axis (each shared face the
+/// same from both sides) and the empty border above, so the box meets boxes of its size or
+/// larger on three sides and unit cubes on the other three, whatever each is accepted as. Every
+/// check of `holds` runs on each. Two tests of four orientations each, which the two test
+/// threads share.
+#[test]
+fn every_down_set_box_of_two_cubes_flips_0_to_3() {
+    down_set_boxes(0..4);
+}
+
+#[test]
+fn every_down_set_box_of_two_cubes_flips_4_to_7() {
+    down_set_boxes(4..8);
+}
+
+/// The volumes of [`every_down_set_box_of_two_cubes_flips_0_to_3`] with orientations `flips`
+/// (bit `d` mirrors axis `d`).
+fn down_set_boxes(flips: std::ops::Range<usize>) {
+    let sets = down_sets();
+    assert_eq!(sets.len(), 980, "plane partitions in a 3×3×3 box");
+    // The sample's place in its tile along one axis: the tile spans 4..=6, its mirror image
+    // 2..=4; the rest is the empty border.
+    let tile = |i: f64| -> Option<usize> {
+        let i = i as usize;
+        (2..=6).contains(&i).then(|| [2, 1, 0, 1, 2][i - 2])
+    };
+    let (mut volumes, mut fewer) = (0, 0);
+    for (k, h) in sets.iter().enumerate() {
+        for flip in flips.clone() {
+            for random in [false, true] {
+                if random && flip != k % 8 {
+                    continue;
+                }
+                let seed = ((k * 8 + flip) * 2 + usize::from(random)) as u64;
+                let vol = volumes::sampled([8, 8, 8], 0.0, |x, y, z| {
+                    let filled = match [x, y, z].map(tile) {
+                        [Some(a), Some(b), Some(c)] => {
+                            let u = |d: usize, v: usize| if flip >> d & 1 == 1 { 2 - v } else { v };
+                            u(2, c) < usize::from(h[u(0, a)][u(1, b)])
+                        }
+                        _ => false,
+                    };
+                    // Magnitudes from 10⁻³ to 1: crossings anywhere along their edges, out to
+                    // the clamp near either sample.
+                    let m = if random {
+                        let at = (x + 8.0 * (y + 8.0 * z)) as u64;
+                        match volumes::splitmix(seed * 4096 + at) % 1000 {
+                            r if r < 100 => 1e-3,
+                            r => r as f64 / 1000.0,
+                        }
+                    } else {
+                        1.0
+                    };
+                    if filled { m } else { -m }
+                });
+                let what = format!("down-set {k} flip {flip} random {random}");
+                let (s123, ours) = holds_with(&vol, 1.0, LIGHT, &what);
+                volumes += 1;
+                fewer += usize::from(ours < s123);
+            }
+        }
+    }
+    // Every pattern in each orientation, and those whose turn it is with random crossings.
+    let turns = (0..980).filter(|k| flips.contains(&(k % 8))).count();
+    assert_eq!(volumes, flips.len() * 980 + turns);
+    // Boxes are accepted, so the test reaches them: most volumes have fewer triangles.
+    assert!(
+        fewer > volumes / 2,
+        "boxes saved triangles in {fewer} of {volumes}"
+    );
+    println!("boxes saved triangles in {fewer} of {volumes} volumes");
 }
