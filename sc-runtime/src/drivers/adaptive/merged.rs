@@ -145,6 +145,8 @@ pub(super) fn unit_triangles(
             merges[m as usize].push_new(k);
         }
     }
+    // What is held from here on is the output: the lists that only found it go first.
+    drop(ring);
     let mut dropped = alloc::vec![false; triangles.len()];
     let mut out = Vec::new();
     let mut kept = Vec::new();
@@ -168,6 +170,7 @@ pub(super) fn unit_triangles(
             kept.push(owner);
         }
     }
+    drop(merges);
     let units = triangles
         .iter()
         .zip(&steps.cubes)

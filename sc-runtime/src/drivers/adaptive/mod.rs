@@ -192,6 +192,7 @@ fn run<T: Scalar>(
         None => grid.emit_units(&merged, |_| false, &tolerance),
     };
     drop(grid);
+    drop(merged);
     let Units {
         mut triangles,
         merges,
@@ -257,8 +258,6 @@ struct Grid<'a, T: Scalar> {
     threshold: T::Threshold,
     /// Vertex edge keys with their ids, sorted by key.
     vertex_of: Vec<(u64, u32)>,
-    /// Triangle ids sorted by their cube's key, with those keys.
-    by_cube: Vec<(u64, u32)>,
     /// The Steps 1–3 triangles, and each one's cube and each vertex's edge.
     triangles: &'a [[u32; 3]],
     rec: &'a Recorded,
@@ -272,17 +271,18 @@ impl<'a, T: Scalar> Grid<'a, T> {
         iso: f64,
         rec: &'a Recorded,
     ) -> Self {
-        // Each key with its index, in key order.
-        let sorted = |keys: &[u64]| -> Vec<(u64, u32)> {
-            let mut v: Vec<(u64, u32)> = keys
-                .iter()
-                .enumerate()
-                .map(|(i, &k)| (k, i as u32))
-                .collect();
-            v.sort_unstable();
-            v
-        };
-        let (vertex_of, by_cube) = (sorted(&rec.edges), sorted(&rec.cubes));
+        // The sweep makes each cube's triangles in turn, cubes in key order, so the triangles
+        // of a cube are a run of `rec.cubes`, found by bisection with no sorted copy. Vertices
+        // come as the cubes first reach their edges, out of key order: each edge key with its
+        // vertex id, in key order.
+        debug_assert!(rec.cubes.is_sorted(), "Steps 1–3 triangles in cube order");
+        let mut vertex_of: Vec<(u64, u32)> = rec
+            .edges
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| (k, i as u32))
+            .collect();
+        vertex_of.sort_unstable();
         Grid {
             data: volume.data(),
             dims: grid,
@@ -291,7 +291,6 @@ impl<'a, T: Scalar> Grid<'a, T> {
             iso,
             threshold: T::threshold(iso),
             vertex_of,
-            by_cube,
             triangles: &rec.mesh.triangles,
             rec,
         }
@@ -330,11 +329,10 @@ impl<'a, T: Scalar> Grid<'a, T> {
         core::array::from_fn(|d| lower[d] as f64 + if d == axis { t } else { 0.0 })
     }
 
-    /// The triangles of the cube with key `cube`.
-    fn cube_range(&self, cube: u64) -> &[(u64, u32)] {
-        let lo = self.by_cube.partition_point(|&(k, _)| k < cube);
-        let hi = self.by_cube.partition_point(|&(k, _)| k <= cube);
-        &self.by_cube[lo..hi]
+    /// The ids of the triangles of the cube with key `cube`, in the order the sweep made them.
+    fn cube_range(&self, cube: u64) -> core::ops::Range<usize> {
+        let cubes = &self.rec.cubes;
+        cubes.partition_point(|&k| k < cube)..cubes.partition_point(|&k| k <= cube)
     }
 
     /// The Steps 1–3 triangles of the box of `side` at `corner`, in the tolerance's units, cube by
@@ -458,18 +456,23 @@ impl<'a, T: Scalar> Grid<'a, T> {
             (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
         let mut out = self.emit_units(merged, in_box, tolerance);
+        let mut parts = Vec::new();
         for (l, (cells, states)) in lattice.iter().enumerate() {
-            let parts = spread.ranges(states.len(), |range| {
+            parts.extend(spread.ranges(states.len(), |range| {
                 let (mut buf, mut triangles) = (PatchBuf::default(), Vec::new());
                 for i in range.filter(|&i| states[i] == Cell::Box) {
                     let at = (unkey(i, *cells), l as u8 + 1);
                     self.emit_box(at, level, pairs, tolerance, &mut buf, &mut triangles);
                 }
                 triangles
-            });
-            for part in parts {
-                out.triangles.extend(part);
-            }
+            }));
+        }
+        // Room for the boxes' triangles at once: grown part by part, the list, the largest
+        // adaptive mode holds, would double past its size as it is copied.
+        out.triangles
+            .reserve_exact(parts.iter().map(Vec::len).sum());
+        for part in parts {
+            out.triangles.extend(part);
         }
         out
     }
@@ -653,8 +656,8 @@ impl<T: Scalar> BoxSource for Grid<'_, T> {
     }
 
     fn cube_triangles(&self, cube: [usize; 3], f: &mut dyn FnMut([[f64; 3]; 3])) {
-        for &(_, i) in self.cube_range(self.key(cube)) {
-            let t = self.triangles[i as usize];
+        for i in self.cube_range(self.key(cube)) {
+            let t = self.triangles[i];
             f(t.map(|v| self.place(self.rec.edges[v as usize])));
         }
     }
