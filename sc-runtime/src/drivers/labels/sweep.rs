@@ -5,7 +5,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{Atlas, Label, LabelParams};
-use alloc::collections::BTreeMap;
+use hashbrown::HashMap;
 use core::ops::Range;
 
 use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
@@ -598,7 +598,7 @@ type Built = ([Local; 3], [u8; 2]);
 #[derive(Default)]
 struct Patterns {
     /// Pattern → its kind and its triangles' range in `triangles`.
-    index: BTreeMap<u32, (Kind, usize, usize)>,
+    index: HashMap<u32, (Kind, usize, usize)>,
     /// Triangles with, per triangle, a corner on the side it faces away from and one on the
     /// side it faces toward.
     triangles: Vec<Built>,
@@ -607,17 +607,7 @@ struct Patterns {
 
 impl Patterns {
     fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[Built]) {
-        let mut sorted = *keys;
-        sorted.sort_unstable();
-        let mut pattern = 0u32;
-        for (c, key) in keys.iter().enumerate() {
-            let rank = sorted[..sorted.partition_point(|k| k < key)]
-                .windows(2)
-                .filter(|w| w[0] != w[1])
-                .count()
-                + usize::from(sorted[0] < *key);
-            pattern |= (rank as u32) << (3 * c);
-        }
+        let pattern = pattern(keys);
         let (kind, start, len) = match self.index.get(&pattern) {
             Some(&found) => found,
             None => {
@@ -636,6 +626,25 @@ impl Patterns {
         };
         (kind, &self.triangles[start..start + len])
     }
+}
+
+/// The order pattern of eight keys: three bits per corner, its key's rank among the distinct
+/// keys. From the 28 comparisons of pairs of corners, without a sort: a corner's rank counts
+/// the smaller keys' first corners.
+#[inline]
+fn pattern<K: Ord>(keys: &[K; 8]) -> u32 {
+    let mut smaller = [0u32; 8];
+    let mut firsts = 0xFFu32;
+    for c in 0..8 {
+        for d in c + 1..8 {
+            match keys[d].cmp(&keys[c]) {
+                core::cmp::Ordering::Less => smaller[c] |= 1 << d,
+                core::cmp::Ordering::Greater => smaller[d] |= 1 << c,
+                core::cmp::Ordering::Equal => firsts &= !(1 << d),
+            }
+        }
+    }
+    (0..8).fold(0, |p, c| p | (smaller[c] & firsts).count_ones() << (3 * c))
 }
 
 /// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
