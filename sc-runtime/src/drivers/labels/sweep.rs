@@ -9,7 +9,7 @@ use hashbrown::HashMap;
 use core::ops::Range;
 
 use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
-use crate::tables::NO_EAR;
+use crate::tables::{Entry, NO_EAR};
 use crate::{Error, Mode, Volume};
 
 const NONE: u32 = u32::MAX;
@@ -433,8 +433,7 @@ pub(super) fn sweep<L: Label>(
         edges: (params.smoothing > 0.0).then(Vec::new),
         pinned: Vec::new(),
     };
-    let table = params.tables.for_mode(params.mode);
-    let mergeable = params.tables.mergeable();
+    let mut binaries = Binaries::new(params);
     let mut patterns = Patterns::default();
     let mut planes = [
         vec![grid.background; nx * ny],
@@ -487,45 +486,29 @@ pub(super) fn sweep<L: Label>(
                     Kind::Uniform => {}
                     Kind::Binary { background, case } => {
                         let class = (cube[0] & 1) | (cube[1] & 1) << 1 | (k & 1) << 2;
-                        let case_at = class * 256 + usize::from(case);
-                        let entry = &table[case_at];
+                        let entry = binaries.get(class * 256 + usize::from(case));
                         let w = labels[usize::from(background)];
-                        let mut first = 0;
-                        for (n, tri) in entry.tris[..usize::from(entry.count)].iter().enumerate() {
-                            let mut t = [0; 3];
-                            for (v, &e) in t.iter_mut().zip(tri) {
-                                *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
-                            }
-                            let (a, b) = edge_corners(tri[0]);
-                            let x = if labels[usize::from(a)] == w {
-                                labels[usize::from(b)]
-                            } else {
-                                labels[usize::from(a)]
-                            };
-                            let id = out.triangle(t, [x, w]);
-                            if n == 0 {
-                                first = id;
-                            }
+                        let mut v = [0; 12];
+                        for (v, &e) in v.iter_mut().zip(&entry.edges[..usize::from(entry.used)]) {
+                            *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
                         }
-                        if params.mode == Mode::Steps123 {
-                            continue;
+                        let first = out.atlas.triangles.len() as u32;
+                        for (tri, &c) in entry.tris[..usize::from(entry.count)]
+                            .iter()
+                            .zip(&entry.other)
+                        {
+                            out.triangle(tri.map(|s| v[usize::from(s)]), [labels[usize::from(c)], w]);
                         }
-                        for axis in 0..3 {
-                            let ear = entry.ears[axis];
-                            if ear == NO_EAR {
-                                continue;
-                            }
-                            let [back, grey, forward] = entry.tris[usize::from(ear)];
-                            let vertex = *ids.edge(here, grey).0 - 1;
+                        for ear in &entry.ears[..usize::from(entry.n_ears)] {
+                            let o = EDGE_LOWER[usize::from(ear.grey)];
                             ears.push(Ear {
-                                vertex,
-                                triangle: first + u32::from(ear),
+                                vertex: v[usize::from(ear.slot)],
+                                triangle: first + u32::from(ear.triangle),
                                 background: w,
-                                mergeable: mergeable[case_at] >> axis & 1 == 1,
-                                diagonal: u8::from(in_diagonal_plane(cube, grey, back))
-                                    | u8::from(in_diagonal_plane(cube, grey, forward)) << 1,
-                                lower: edge_lower(cube, grey),
-                                axis,
+                                mergeable: ear.mergeable,
+                                diagonal: ear.diagonal,
+                                lower: [cube[0] + o[0], cube[1] + o[1], cube[2] + o[2]],
+                                axis: usize::from(ear.axis),
                             });
                         }
                     }
@@ -585,6 +568,115 @@ pub(super) fn sweep<L: Label>(
         top,
         emitters,
     })
+}
+
+/// A binary table entry as the sweep reads it, derived from the entry when first met.
+#[derive(Clone, Copy, Default)]
+struct Binary {
+    /// The entry's edges in order of first use: their vertices, looked up in that order, are
+    /// made in the order the triangles would make them, and each is looked up once.
+    edges: [u8; 12],
+    used: u8,
+    /// Triangles as indices into `edges`.
+    tris: [[u8; 3]; 5],
+    /// Per triangle, the corner of its first edge that is not the background's: its label is
+    /// the one the triangle faces away from.
+    other: [u8; 5],
+    count: u8,
+    /// The ears Step 4 may merge; none in Steps 1–3.
+    ears: [BinaryEar; 3],
+    n_ears: u8,
+    ready: bool,
+}
+
+/// What [`Ear`] takes from a binary entry.
+#[derive(Clone, Copy, Default)]
+struct BinaryEar {
+    /// The ear's triangle in the entry, its grey edge, and the grey edge's index in
+    /// [`Binary::edges`].
+    triangle: u8,
+    grey: u8,
+    slot: u8,
+    axis: u8,
+    mergeable: bool,
+    diagonal: u8,
+}
+
+/// The entries of a mode's table as [`Binary`], each derived when first met.
+struct Binaries {
+    table: &'static [Entry; 2048],
+    mergeable: &'static [u8; 2048],
+    ears: bool,
+    derived: Vec<Binary>,
+}
+
+impl Binaries {
+    fn new<L>(params: &LabelParams<L>) -> Self {
+        Binaries {
+            table: params.tables.for_mode(params.mode),
+            mergeable: params.tables.mergeable(),
+            ears: params.mode != Mode::Steps123,
+            derived: vec![Binary::default(); 2048],
+        }
+    }
+
+    /// Entry `case_at` (`class * 256 + case`).
+    #[inline]
+    fn get(&mut self, case_at: usize) -> &Binary {
+        if !self.derived[case_at].ready {
+            self.derived[case_at] = self.derive(case_at);
+        }
+        &self.derived[case_at]
+    }
+
+    fn derive(&self, case_at: usize) -> Binary {
+        let entry = &self.table[case_at];
+        let case = case_at as u8;
+        let mut b = Binary {
+            count: entry.count,
+            ready: true,
+            ..Binary::default()
+        };
+        let slot = |b: &mut Binary, e: u8| match b.edges[..usize::from(b.used)]
+            .iter()
+            .position(|&f| f == e)
+        {
+            Some(s) => s as u8,
+            None => {
+                b.edges[usize::from(b.used)] = e;
+                b.used += 1;
+                b.used - 1
+            }
+        };
+        for (n, tri) in entry.tris[..usize::from(entry.count)].iter().enumerate() {
+            b.tris[n] = tri.map(|e| slot(&mut b, e));
+            let (c0, c1) = edge_corners(tri[0]);
+            b.other[n] = if case >> c0 & 1 == 1 { c0 } else { c1 };
+        }
+        if self.ears {
+            // The class's parity bits stand for the cube's: diagonals depend on nothing else.
+            let class = case_at / 256;
+            let cube = [class & 1, class >> 1 & 1, class >> 2 & 1];
+            for axis in 0..3 {
+                let ear = entry.ears[axis];
+                if ear == NO_EAR {
+                    continue;
+                }
+                let [back, grey, forward] = entry.tris[usize::from(ear)];
+                b.ears[usize::from(b.n_ears)] = BinaryEar {
+                    triangle: ear,
+                    grey,
+                    slot: slot(&mut b, grey),
+                    axis: axis as u8,
+                    mergeable: self.mergeable[case_at] >> axis & 1 == 1,
+                    diagonal: u8::from(in_diagonal_plane(cube, grey, back))
+                        | u8::from(in_diagonal_plane(cube, grey, forward)) << 1,
+                };
+                b.n_ears += 1;
+            }
+        }
+        b
+    }
 }
 
 /// A junction cube's triangle, with a corner on the side it faces away from and one on the
