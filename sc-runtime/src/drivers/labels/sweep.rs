@@ -330,9 +330,11 @@ fn shared(
 /// The sweep's output so far.
 struct Out<'p, L> {
     atlas: &'p mut Atlas<L>,
-    spacing: [f64; 3],
-    /// The world position of padded sample `(0, 0, 0)`.
-    origin: [f64; 3],
+    /// Per axis, the world coordinate of each quarter of a cube side over the box's cubes,
+    /// from its first cube's lower corner: a vertex's position is three loads.
+    coordinates: [Vec<f32>; 3],
+    /// The box's first cube.
+    start: [usize; 3],
     /// With smoothing, per vertex: the grid edge it lies on (lower end, axis), or
     /// [`NOT_ON_AN_EDGE`].
     edges: Option<Vec<Edge>>,
@@ -355,8 +357,7 @@ impl<L> Out<'_, L> {
             return Err(Error::TooManyVertices);
         }
         let p: [f32; 3] = core::array::from_fn(|a| {
-            (self.origin[a] + (cube[a] as f64 + f64::from(quarters[a]) / 4.0) * self.spacing[a])
-                as f32
+            self.coordinates[a][4 * (cube[a] - self.start[a]) + quarters[a] as usize]
         });
         self.atlas.positions.push(p);
         if let Some(edges) = &mut self.edges {
@@ -428,8 +429,17 @@ pub(super) fn sweep<L: Label>(
     let pad = f64::from(u8::from(params.pad));
     let mut out = Out {
         atlas: &mut atlas,
-        spacing: params.spacing,
-        origin: core::array::from_fn(|a| params.origin[a] - pad * params.spacing[a]),
+        coordinates: core::array::from_fn(|a| {
+            // The world position of padded sample 0 along the axis.
+            let origin = params.origin[a] - pad * params.spacing[a];
+            (4 * cubes[a].start..=4 * cubes[a].end)
+                .map(|q| {
+                    let (cube, quarter) = (q / 4, q % 4);
+                    (origin + (cube as f64 + quarter as f64 / 4.0) * params.spacing[a]) as f32
+                })
+                .collect()
+        }),
+        start: cubes.clone().map(|r| r.start),
         edges: (params.smoothing > 0.0).then(Vec::new),
         pinned: Vec::new(),
     };
