@@ -488,8 +488,8 @@ pub(super) fn sweep<L: Label>(
                         vertex: out.atlas.positions.len() as u32,
                     });
                 }
-                let (kind, built) = match few_labels(&labels) {
-                    Some(kind) => (grid.by_key(&labels, kind), &[][..]),
+                let (kind, nodes, built) = match few_labels(&labels) {
+                    Some(kind) => (grid.by_key(&labels, kind), &[][..], &[][..]),
                     None => patterns.get(&labels.map(|l| grid.key(l))),
                 };
                 match kind {
@@ -523,39 +523,22 @@ pub(super) fn sweep<L: Label>(
                         }
                     }
                     Kind::Junction => {
-                        let mut own = [NONE; 27];
-                        for &(triangle, [a, b]) in built {
-                            let mut t = [0; 3];
-                            for (v, &local) in t.iter_mut().zip(&triangle) {
-                                *v = match local {
-                                    Local::Edge(e) => {
-                                        edge_vertex(&mut ids, &mut out, cube, here, e)?
-                                    }
-                                    Local::Face(f) => shared(ids.face([i, j, k], f), || {
-                                        out.vertex(cube, local.quarters())
-                                    })?,
-                                    Local::Centre | Local::InnerNode(_) | Local::InnerCorner(_) => {
-                                        let s = match local {
-                                            Local::Centre => 0,
-                                            Local::InnerNode(n) => 1 + usize::from(n),
-                                            Local::InnerCorner(c) => 19 + usize::from(c),
-                                            _ => unreachable!(),
-                                        };
-                                        if own[s] == NONE {
-                                            own[s] = out.vertex(cube, local.quarters())?;
-                                        }
-                                        own[s]
-                                    }
-                                };
-                            }
-                            out.triangle(t, [labels[usize::from(a)], labels[usize::from(b)]]);
-                            // A hub's walls and floors are radial from the cube's centre only
-                            // with their nodes at midpoints: smoothing leaves them there.
-                            if out.edges.is_some()
-                                && triangle.iter().any(|l| {
-                                    matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))
-                                })
-                            {
+                        let mut v = [0; JUNCTION_NODES];
+                        for (v, &node) in v.iter_mut().zip(nodes) {
+                            *v = match node {
+                                Local::Edge(e) => edge_vertex(&mut ids, &mut out, cube, here, e)?,
+                                Local::Face(f) => shared(ids.face([i, j, k], f), || {
+                                    out.vertex(cube, node.quarters())
+                                })?,
+                                // The centre and the inner vertices are the cube's own.
+                                _ => out.vertex(cube, node.quarters())?,
+                            };
+                        }
+                        for b in built {
+                            let t = b.nodes.map(|s| v[usize::from(s)]);
+                            let [x, y] = b.pair.map(|c| labels[usize::from(c)]);
+                            out.triangle(t, [x, y]);
+                            if b.pinned && out.edges.is_some() {
                                 out.pinned.extend(t);
                             }
                         }
@@ -689,9 +672,29 @@ impl Binaries {
     }
 }
 
-/// A junction cube's triangle, with a corner on the side it faces away from and one on the
-/// side it faces toward.
-type Built = ([Local; 3], [u8; 2]);
+/// A junction cube's triangle: its vertices as indices into its pattern's nodes, a corner on
+/// the side it faces away from and one on the side it faces toward, and whether smoothing
+/// leaves its vertices where they are made (a hub's walls and floors are radial from the
+/// cube's centre only with their nodes at midpoints).
+#[derive(Clone, Copy)]
+struct Built {
+    nodes: [u8; 3],
+    pair: [u8; 2],
+    pinned: bool,
+}
+
+/// The most vertices a junction cube uses: 12 edges, 6 faces, the centre, 18 inner nodes and
+/// 8 inner corners.
+const JUNCTION_NODES: usize = 45;
+
+/// A pattern's construction: its kind, and for a junction the ranges of its nodes (in
+/// `Patterns::nodes`) and triangles (in `Patterns::triangles`).
+#[derive(Clone, Copy)]
+struct Construction {
+    kind: Kind,
+    nodes: (usize, usize),
+    triangles: (usize, usize),
+}
 
 /// The constructions of cubes with three or more labels met so far, by the order pattern of
 /// their corners' labels: a segmentation has few patterns, and building one takes thousands of
@@ -699,34 +702,60 @@ type Built = ([Local; 3], [u8; 2]);
 /// pattern are built alike.
 #[derive(Default)]
 struct Patterns {
-    /// Pattern → its kind and its triangles' range in `triangles`.
-    index: HashMap<u32, (Kind, usize, usize)>,
-    /// Triangles with, per triangle, a corner on the side it faces away from and one on the
-    /// side it faces toward.
+    index: HashMap<u32, Construction>,
+    /// Per junction pattern, the vertices its triangles use, in order of first use: a cube
+    /// makes or finds each once, in the order its triangles would.
+    nodes: Vec<Local>,
     triangles: Vec<Built>,
     built: Junction,
 }
 
 impl Patterns {
-    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[Built]) {
+    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[Local], &[Built]) {
         let pattern = pattern(keys);
-        let (kind, start, len) = match self.index.get(&pattern) {
+        let found = match self.index.get(&pattern) {
             Some(&found) => found,
             None => {
                 let kind = classify(keys);
-                let start = self.triangles.len();
+                let (nodes, triangles) = (self.nodes.len(), self.triangles.len());
                 if kind == Kind::Junction {
                     junction(keys, &mut self.built);
                     let b = &self.built;
-                    self.triangles
-                        .extend((0..b.len).map(|n| (b.triangles[n], b.pairs[n])));
+                    for n in 0..b.len {
+                        let triangle = b.triangles[n].map(|local| {
+                            let mine = &mut self.nodes;
+                            let s = match mine[nodes..].iter().position(|&l| l == local) {
+                                Some(s) => s,
+                                None => {
+                                    mine.push(local);
+                                    mine.len() - 1 - nodes
+                                }
+                            };
+                            s as u8
+                        });
+                        self.triangles.push(Built {
+                            nodes: triangle,
+                            pair: b.pairs[n],
+                            pinned: b.triangles[n].iter().any(|l| {
+                                matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))
+                            }),
+                        });
+                    }
                 }
-                let entry = (kind, start, self.triangles.len() - start);
-                self.index.insert(pattern, entry);
-                entry
+                let found = Construction {
+                    kind,
+                    nodes: (nodes, self.nodes.len()),
+                    triangles: (triangles, self.triangles.len()),
+                };
+                self.index.insert(pattern, found);
+                found
             }
         };
-        (kind, &self.triangles[start..start + len])
+        (
+            found.kind,
+            &self.nodes[found.nodes.0..found.nodes.1],
+            &self.triangles[found.triangles.0..found.triangles.1],
+        )
     }
 }
 
@@ -813,7 +842,8 @@ const EDGE_LOWER: [[usize; 3]; 12] = {
 };
 
 /// The vertex on cube edge `e`, made at its midpoint when first used.
-#[inline]
+// Always inlined, as `shared` is: out of line, the call costs more than the lookup.
+#[inline(always)]
 fn edge_vertex<L>(
     ids: &mut Ids,
     out: &mut Out<'_, L>,
