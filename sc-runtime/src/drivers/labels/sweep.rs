@@ -351,9 +351,9 @@ pub(super) const NOT_ON_AN_EDGE: Edge = [u32::MAX; 4];
 impl<L> Out<'_, L> {
     /// A new vertex at `quarters` (quarters of a cube side) from `cube`'s lower corner.
     fn vertex(&mut self, cube: [usize; 3], quarters: [i32; 3]) -> Result<u32, Error> {
-        let id = u32::try_from(self.atlas.positions.len()).map_err(|_| Error::TooManyVertices)?;
-        // Ids are stored plus one (see `Ids`).
-        if id >= NONE - 1 {
+        let id = self.atlas.positions.len();
+        // Ids are u32, and stored plus one (see `Ids`).
+        if id >= (NONE - 1) as usize {
             return Err(Error::TooManyVertices);
         }
         let p: [f32; 3] = core::array::from_fn(|a| {
@@ -363,7 +363,7 @@ impl<L> Out<'_, L> {
         if let Some(edges) = &mut self.edges {
             edges.push(NOT_ON_AN_EDGE);
         }
-        Ok(id)
+        Ok(id as u32)
     }
 
     /// A new vertex at the midpoint of cube edge `e` of `cube`.
