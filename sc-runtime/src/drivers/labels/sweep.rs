@@ -227,8 +227,10 @@ struct Ids {
     slots: Vec<u32>,
     /// Per plane, the first id made since it came into reach.
     since: [u32; 9],
-    /// Per cube edge, in the current layer: its plane and its offset from the cube's slot.
-    edges: [(usize, usize); 12],
+    /// Per cube edge, in the current layer: its offset from the cube's slot, and the first id
+    /// its plane may hold (a copy of `since`, fixed for the layer). Sixteen, so that an edge
+    /// masked to four bits needs no bound check.
+    edges: [(usize, u32); 16],
 }
 
 impl Ids {
@@ -244,7 +246,7 @@ impl Ids {
             nx,
             slots: vec![0; 9 * nx * ny],
             since: [0; 9],
-            edges: [(0, 0); 12],
+            edges: [(0, 0); 16],
         }
     }
 
@@ -265,14 +267,14 @@ impl Ids {
             }
         }
         let n = self.plane_len();
-        for (e, slot) in self.edges.iter_mut().enumerate() {
+        for (e, slot) in self.edges[..12].iter_mut().enumerate() {
             let [dx, dy, dz] = EDGE_LOWER[e];
             let plane = match edge_axis(e as u8) {
                 0 => Self::X + (k + dz) % 2,
                 1 => Self::Y + (k + dz) % 2,
                 _ => Self::Z,
             };
-            *slot = (plane, plane * n + dx + self.nx * dy);
+            *slot = (plane * n + dx + self.nx * dy, self.since[plane]);
         }
     }
 
@@ -294,8 +296,8 @@ impl Ids {
     /// layer, and the first id it may hold.
     #[inline]
     fn edge(&mut self, at: usize, e: u8) -> (&mut u32, u32) {
-        let (plane, offset) = self.edges[usize::from(e)];
-        (&mut self.slots[offset + at], self.since[plane])
+        let (offset, since) = self.edges[usize::from(e & 15)];
+        (&mut self.slots[offset + at], since)
     }
 
     /// [`Ids::edge`] for the centre of face `f` of the cube `[i, j, k]` (`i`, `j` from the
@@ -449,7 +451,8 @@ pub(super) fn sweep<L: Label>(
         vec![grid.background; nx * ny],
         vec![grid.background; nx * ny],
     ];
-    let mut mask = vec![0u8; nx - 1];
+    // Padded for `changed`; `differs` writes the first `nx − 1`.
+    let mut mask = vec![0u8; (nx - 1).next_multiple_of(8)];
     let mut bottom = [Vec::new(), Vec::new(), Vec::new()];
     let first = layers.start;
     grid.plane(first, xs.clone(), ys.clone(), &mut planes[first % 2]);
@@ -467,7 +470,7 @@ pub(super) fn sweep<L: Label>(
                 &upper[j * nx..][..nx],
                 &upper[(j + 1) * nx..][..nx],
             ];
-            differs(rows, &mut mask);
+            differs(rows, &mut mask[..nx - 1]);
             for i in changed(&mask) {
                 let labels = [
                     rows[0][i],
@@ -779,11 +782,10 @@ fn pattern<K: Ord>(keys: &[K; 8]) -> u32 {
 }
 
 /// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
+/// The mask is padded with zeros to a multiple of eight, so each word is one load.
 fn changed(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
-    mask.chunks(8).enumerate().flat_map(|(n, chunk)| {
-        let mut bytes = [0u8; 8];
-        bytes[..chunk.len()].copy_from_slice(chunk);
-        let mut word = u64::from_le_bytes(bytes);
+    mask.chunks_exact(8).enumerate().flat_map(|(n, chunk)| {
+        let mut word = u64::from_le_bytes(chunk.try_into().unwrap_or_default());
         core::iter::from_fn(move || {
             let k = word.trailing_zeros() / 8;
             (word != 0).then(|| {
