@@ -500,8 +500,9 @@ pub(super) fn sweep<L: Label>(
                     Kind::Binary { background, case } => {
                         let class = (cube[0] & 1) | (cube[1] & 1) << 1 | (k & 1) << 2;
                         let entry = binaries.get(class * 256 + usize::from(case));
-                        let w = labels[usize::from(background)];
-                        let mut v = [0; 12];
+                        let w = labels[usize::from(background & 7)];
+                        // Sixteen slots, indexed by four bits: no bound checks.
+                        let mut v = [0; 16];
                         for (v, &e) in v.iter_mut().zip(&entry.edges[..usize::from(entry.used)]) {
                             *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
                         }
@@ -510,17 +511,18 @@ pub(super) fn sweep<L: Label>(
                             .iter()
                             .zip(&entry.other)
                         {
-                            out.triangle(tri.map(|s| v[usize::from(s)]), [labels[usize::from(c)], w]);
+                            let t = tri.map(|s| v[usize::from(s & 15)]);
+                            out.triangle(t, [labels[usize::from(c & 7)], w]);
                         }
                         for ear in &entry.ears[..usize::from(entry.n_ears)] {
-                            let o = EDGE_LOWER[usize::from(ear.grey)];
+                            let o = ear.lower;
                             ears.push(Ear {
-                                vertex: v[usize::from(ear.slot)],
+                                vertex: v[usize::from(ear.slot & 15)],
                                 triangle: first + u32::from(ear.triangle),
                                 background: w,
                                 mergeable: ear.mergeable,
                                 diagonal: ear.diagonal,
-                                lower: [cube[0] + o[0], cube[1] + o[1], cube[2] + o[2]],
+                                lower: core::array::from_fn(|a| cube[a] + usize::from(o[a])),
                                 axis: usize::from(ear.axis),
                             });
                         }
@@ -588,11 +590,11 @@ struct Binary {
 /// What [`Ear`] takes from a binary entry.
 #[derive(Clone, Copy, Default)]
 struct BinaryEar {
-    /// The ear's triangle in the entry, its grey edge, and the grey edge's index in
-    /// [`Binary::edges`].
+    /// The ear's triangle in the entry, its grey edge's index in [`Binary::edges`] and lower
+    /// end (from the cube's lower corner).
     triangle: u8,
-    grey: u8,
     slot: u8,
+    lower: [u8; 3],
     axis: u8,
     mergeable: bool,
     diagonal: u8,
@@ -661,8 +663,8 @@ impl Binaries {
                 let [back, grey, forward] = entry.tris[usize::from(ear)];
                 b.ears[usize::from(b.n_ears)] = BinaryEar {
                     triangle: ear,
-                    grey,
                     slot: slot(&mut b, grey),
+                    lower: EDGE_LOWER[usize::from(grey)].map(|o| o as u8),
                     axis: axis as u8,
                     mergeable: self.mergeable[case_at] >> axis & 1 == 1,
                     diagonal: u8::from(in_diagonal_plane(cube, grey, back))
