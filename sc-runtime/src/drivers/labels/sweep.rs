@@ -493,7 +493,7 @@ pub(super) fn sweep<L: Label>(
                 }
                 let (kind, nodes, built) = match few_labels(&labels) {
                     Some(kind) => (grid.by_key(&labels, kind), &[][..], &[][..]),
-                    None => patterns.get(&labels.map(|l| grid.key(l))),
+                    None => patterns.get(grid, &labels),
                 };
                 match kind {
                     Kind::Uniform => {}
@@ -716,11 +716,13 @@ struct Patterns {
 }
 
 impl Patterns {
-    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[Local], &[Built]) {
-        let pattern = pattern(keys);
+    /// The construction of a cube of `labels` on `grid`.
+    fn get<L: Label>(&mut self, grid: &Padded<'_, L>, labels: &[L; 8]) -> (Kind, &[Local], &[Built]) {
+        let pattern = pattern(labels, grid.background);
         let found = match self.index.get(&pattern) {
             Some(&found) => found,
             None => {
+                let keys = &labels.map(|l| grid.key(l));
                 let kind = classify(keys);
                 let (nodes, triangles) = (self.nodes.len(), self.triangles.len());
                 if kind == Kind::Junction {
@@ -764,23 +766,33 @@ impl Patterns {
     }
 }
 
-/// The order pattern of eight keys: three bits per corner, its key's rank among the distinct
-/// keys. From the 28 comparisons of pairs of corners, without a sort: a corner's rank counts
-/// the smaller keys' first corners.
+/// The order pattern of a cube's keys ([`Padded::key`]): three bits per corner, its key's rank
+/// among the distinct keys. From the 28 comparisons of pairs of labels, without a sort: a
+/// corner's rank counts the smaller keys' first corners. Keys order labels as the labels do,
+/// but for the background, which comes first: comparing labels is cheaper than comparing keys.
 #[inline]
-fn pattern<K: Ord>(keys: &[K; 8]) -> u32 {
+fn pattern<L: Ord + Copy>(labels: &[L; 8], background: L) -> u32 {
     let mut smaller = [0u32; 8];
     let mut firsts = 0xFFu32;
+    let mut backgrounds = 0u32;
     for c in 0..8 {
+        backgrounds |= u32::from(labels[c] == background) << c;
         for d in c + 1..8 {
-            match keys[d].cmp(&keys[c]) {
+            match labels[d].cmp(&labels[c]) {
                 core::cmp::Ordering::Less => smaller[c] |= 1 << d,
                 core::cmp::Ordering::Greater => smaller[d] |= 1 << c,
                 core::cmp::Ordering::Equal => firsts &= !(1 << d),
             }
         }
     }
-    (0..8).fold(0, |p, c| p | (smaller[c] & firsts).count_ones() << (3 * c))
+    (0..8).fold(0, |p, c| {
+        let below = if backgrounds >> c & 1 == 1 {
+            0
+        } else {
+            smaller[c] & !backgrounds | backgrounds
+        };
+        p | (below & firsts).count_ones() << (3 * c)
+    })
 }
 
 /// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
@@ -869,5 +881,30 @@ fn in_diagonal_plane(cube: [usize; 3], grey: u8, e: u8) -> bool {
         2 if g[2].is_multiple_of(2) => axis != 0 && p[0] == g[0],
         2 => axis != 1 && p[1] == g[1],
         _ => axis != 2 && p[2] == g[2],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`pattern`] is each corner's rank among the distinct keys, as sorting the keys gives it,
+    /// for every labelling of a cube with four labels, the background each of them in turn.
+    #[test]
+    fn pattern_ranks_keys() {
+        for background in 0u8..4 {
+            for n in 0..4u32.pow(8) {
+                let labels: [u8; 8] = core::array::from_fn(|c| (n >> (2 * c) & 3) as u8);
+                let keys = labels.map(|l| (l != background, l));
+                let mut distinct = keys.to_vec();
+                distinct.sort_unstable();
+                distinct.dedup();
+                let sorted = (0..8).fold(0, |p, c| {
+                    let rank = distinct.iter().position(|k| *k == keys[c]).unwrap();
+                    p | (rank as u32) << (3 * c)
+                });
+                assert_eq!(pattern(&labels, background), sorted, "{labels:?}, {background}");
+            }
+        }
     }
 }
