@@ -797,17 +797,37 @@ fn pattern<L: Ord + Copy>(labels: &[L; 8], background: L) -> u32 {
 
 /// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
 /// The mask is padded with zeros to a multiple of eight, so each word is one load.
-fn changed(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
-    mask.chunks_exact(8).enumerate().flat_map(|(n, chunk)| {
-        let mut word = u64::from_le_bytes(chunk.try_into().unwrap_or_default());
-        core::iter::from_fn(move || {
-            let k = word.trailing_zeros() / 8;
-            (word != 0).then(|| {
-                word &= !(0xFF << (8 * k));
-                8 * n + k as usize
-            })
-        })
-    })
+fn changed(mask: &[u8]) -> Changed<'_> {
+    Changed {
+        mask,
+        next: 0,
+        word: 0,
+    }
+}
+
+/// The iterator of [`changed`]: a word of the mask and where the next starts, which is less
+/// state for the sweep's loop to keep than a chain of adapters.
+struct Changed<'a> {
+    mask: &'a [u8],
+    next: usize,
+    word: u64,
+}
+
+impl Iterator for Changed<'_> {
+    type Item = usize;
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.word == 0 {
+            let bytes = self.mask.get(self.next..self.next + 8)?;
+            self.word = u64::from_le_bytes(bytes.try_into().unwrap_or_default());
+            self.next += 8;
+        }
+        let k = self.word.trailing_zeros() as usize / 8;
+        // Each byte is 0 or 1: clearing the lowest bit set clears its byte.
+        self.word &= self.word - 1;
+        Some(self.next - 8 + k)
+    }
 }
 
 /// Per cube of a row, 1 if its eight corners (`rows`: y and y + 1 at z, then at z + 1) do not
