@@ -507,13 +507,18 @@ pub(super) fn sweep<L: Label>(
                             *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
                         }
                         let first = out.atlas.triangles.len() as u32;
-                        for (tri, &c) in entry.tris[..usize::from(entry.count)]
-                            .iter()
-                            .zip(&entry.other)
-                        {
-                            let t = tri.map(|s| v[usize::from(s & 15)]);
-                            out.triangle(t, [labels[usize::from(c & 7)], w]);
-                        }
+                        // Extended from slices rather than pushed: one capacity check each.
+                        let count = usize::from(entry.count);
+                        out.atlas.triangles.extend(
+                            entry.tris[..count]
+                                .iter()
+                                .map(|tri| tri.map(|s| v[usize::from(s & 15)])),
+                        );
+                        out.atlas.pairs.extend(
+                            entry.other[..count]
+                                .iter()
+                                .map(|&c| [labels[usize::from(c & 7)], w]),
+                        );
                         for ear in &entry.ears[..usize::from(entry.n_ears)] {
                             let o = ear.lower;
                             ears.push(Ear {
