@@ -5,8 +5,8 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{Atlas, Label, LabelParams};
-use hashbrown::HashMap;
 use core::ops::Range;
+use hashbrown::HashMap;
 
 use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
 use crate::tables::{Entry, NO_EAR};
@@ -722,7 +722,11 @@ struct Patterns {
 
 impl Patterns {
     /// The construction of a cube of `labels` on `grid`.
-    fn get<L: Label>(&mut self, grid: &Padded<'_, L>, labels: &[L; 8]) -> (Kind, &[Local], &[Built]) {
+    fn get<L: Label>(
+        &mut self,
+        grid: &Padded<'_, L>,
+        labels: &[L; 8],
+    ) -> (Kind, &[Local], &[Built]) {
         let pattern = pattern(labels, grid.background);
         let found = match self.index.get(&pattern) {
             Some(&found) => found,
@@ -748,9 +752,9 @@ impl Patterns {
                         self.triangles.push(Built {
                             nodes: triangle,
                             pair: b.pairs[n],
-                            pinned: b.triangles[n].iter().any(|l| {
-                                matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))
-                            }),
+                            pinned: b.triangles[n]
+                                .iter()
+                                .any(|l| matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))),
                         });
                     }
                 }
@@ -928,7 +932,11 @@ mod tests {
                     let rank = distinct.iter().position(|k| *k == keys[c]).unwrap();
                     p | (rank as u32) << (3 * c)
                 });
-                assert_eq!(pattern(&labels, background), sorted, "{labels:?}, {background}");
+                assert_eq!(
+                    pattern(&labels, background),
+                    sorted,
+                    "{labels:?}, {background}"
+                );
             }
         }
     }
