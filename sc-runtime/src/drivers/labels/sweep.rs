@@ -378,12 +378,6 @@ impl<L> Out<'_, L> {
         }
         Ok(id)
     }
-
-    fn triangle(&mut self, t: [u32; 3], pair: [L; 2]) -> u32 {
-        self.atlas.triangles.push(t);
-        self.atlas.pairs.push(pair);
-        (self.atlas.triangles.len() - 1) as u32
-    }
 }
 
 /// The output of a run of layers, to be joined with its neighbours'.
@@ -533,7 +527,9 @@ pub(super) fn sweep<L: Label>(
                         }
                     }
                     Kind::Junction => {
-                        let mut v = [0; JUNCTION_NODES];
+                        // Sixty-four slots, indexed by six bits: no bound checks. A junction uses
+                        // at most 45 (12 edges, 6 faces, the centre, 18 inner nodes, 8 corners).
+                        let mut v = [0; 64];
                         for (v, &node) in v.iter_mut().zip(nodes) {
                             *v = match node {
                                 Local::Edge(e) => edge_vertex(&mut ids, &mut out, cube, here, e)?,
@@ -544,13 +540,17 @@ pub(super) fn sweep<L: Label>(
                                 _ => out.vertex(cube, node.quarters())?,
                             };
                         }
-                        for b in built {
-                            let t = b.nodes.map(|s| v[usize::from(s)]);
-                            let [x, y] = b.pair.map(|c| labels[usize::from(c)]);
-                            out.triangle(t, [x, y]);
-                            if b.pinned && out.edges.is_some() {
-                                out.pinned.extend(t);
-                            }
+                        let corners = |b: &Built| b.nodes.map(|s| v[usize::from(s & 63)]);
+                        // Extended, as a binary cube's are: one capacity check each.
+                        out.atlas.triangles.extend(built.iter().map(corners));
+                        out.atlas
+                            .pairs
+                            .extend(built.iter().map(|b| b.pair).map(|[x, y]| {
+                                [labels[usize::from(x & 7)], labels[usize::from(y & 7)]]
+                            }));
+                        if out.edges.is_some() {
+                            let pinned = built.iter().filter(|b| b.pinned);
+                            out.pinned.extend(pinned.flat_map(corners));
                         }
                     }
                 }
@@ -692,10 +692,6 @@ struct Built {
     pair: [u8; 2],
     pinned: bool,
 }
-
-/// The most vertices a junction cube uses: 12 edges, 6 faces, the centre, 18 inner nodes and
-/// 8 inner corners.
-const JUNCTION_NODES: usize = 45;
 
 /// A pattern's construction: its kind, and for a junction the ranges of its nodes (in
 /// `Patterns::nodes`) and triangles (in `Patterns::triangles`).
