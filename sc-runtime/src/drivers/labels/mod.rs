@@ -471,7 +471,8 @@ fn each_side<L: Label>(
     for (t, &pair) in triangles.iter().zip(pairs) {
         let found = match last {
             Some((p, found)) if p == pair => found,
-            _ => pair.map(|l| find.get(l)),
+            // Not `pair.map`: an array's `map` is a call per element here.
+            _ => [find.get(pair[0]), find.get(pair[1])],
         };
         last = Some((pair, found));
         if let Some(i) = found[0] {

@@ -5,11 +5,11 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{Atlas, Label, LabelParams};
-use alloc::collections::BTreeMap;
 use core::ops::Range;
+use hashbrown::HashMap;
 
 use crate::kernel::labels::{Junction, Kind, Local, classify, edge_corners, few_labels, junction};
-use crate::tables::NO_EAR;
+use crate::tables::{Entry, NO_EAR};
 use crate::{Error, Mode, Volume};
 
 const NONE: u32 = u32::MAX;
@@ -227,8 +227,10 @@ struct Ids {
     slots: Vec<u32>,
     /// Per plane, the first id made since it came into reach.
     since: [u32; 9],
-    /// Per cube edge, in the current layer: its plane and its offset from the cube's slot.
-    edges: [(usize, usize); 12],
+    /// Per cube edge, in the current layer: its offset from the cube's slot, and the first id
+    /// its plane may hold (a copy of `since`, fixed for the layer). Sixteen, so that an edge
+    /// masked to four bits needs no bound check.
+    edges: [(usize, u32); 16],
 }
 
 impl Ids {
@@ -244,7 +246,7 @@ impl Ids {
             nx,
             slots: vec![0; 9 * nx * ny],
             since: [0; 9],
-            edges: [(0, 0); 12],
+            edges: [(0, 0); 16],
         }
     }
 
@@ -265,14 +267,14 @@ impl Ids {
             }
         }
         let n = self.plane_len();
-        for (e, slot) in self.edges.iter_mut().enumerate() {
+        for (e, slot) in self.edges[..12].iter_mut().enumerate() {
             let [dx, dy, dz] = EDGE_LOWER[e];
             let plane = match edge_axis(e as u8) {
                 0 => Self::X + (k + dz) % 2,
                 1 => Self::Y + (k + dz) % 2,
                 _ => Self::Z,
             };
-            *slot = (plane, plane * n + dx + self.nx * dy);
+            *slot = (plane * n + dx + self.nx * dy, self.since[plane]);
         }
     }
 
@@ -294,8 +296,8 @@ impl Ids {
     /// layer, and the first id it may hold.
     #[inline]
     fn edge(&mut self, at: usize, e: u8) -> (&mut u32, u32) {
-        let (plane, offset) = self.edges[usize::from(e)];
-        (&mut self.slots[offset + at], self.since[plane])
+        let (offset, since) = self.edges[usize::from(e & 15)];
+        (&mut self.slots[offset + at], since)
     }
 
     /// [`Ids::edge`] for the centre of face `f` of the cube `[i, j, k]` (`i`, `j` from the
@@ -330,9 +332,11 @@ fn shared(
 /// The sweep's output so far.
 struct Out<'p, L> {
     atlas: &'p mut Atlas<L>,
-    spacing: [f64; 3],
-    /// The world position of padded sample `(0, 0, 0)`.
-    origin: [f64; 3],
+    /// Per axis, the world coordinate of each quarter of a cube side over the box's cubes,
+    /// from its first cube's lower corner: a vertex's position is three loads.
+    coordinates: [Vec<f32>; 3],
+    /// The box's first cube.
+    start: [usize; 3],
     /// With smoothing, per vertex: the grid edge it lies on (lower end, axis), or
     /// [`NOT_ON_AN_EDGE`].
     edges: Option<Vec<Edge>>,
@@ -349,20 +353,19 @@ pub(super) const NOT_ON_AN_EDGE: Edge = [u32::MAX; 4];
 impl<L> Out<'_, L> {
     /// A new vertex at `quarters` (quarters of a cube side) from `cube`'s lower corner.
     fn vertex(&mut self, cube: [usize; 3], quarters: [i32; 3]) -> Result<u32, Error> {
-        let id = u32::try_from(self.atlas.positions.len()).map_err(|_| Error::TooManyVertices)?;
-        // Ids are stored plus one (see `Ids`).
-        if id >= NONE - 1 {
+        let id = self.atlas.positions.len();
+        // Ids are u32, and stored plus one (see `Ids`).
+        if id >= (NONE - 1) as usize {
             return Err(Error::TooManyVertices);
         }
         let p: [f32; 3] = core::array::from_fn(|a| {
-            (self.origin[a] + (cube[a] as f64 + f64::from(quarters[a]) / 4.0) * self.spacing[a])
-                as f32
+            self.coordinates[a][4 * (cube[a] - self.start[a]) + quarters[a] as usize]
         });
         self.atlas.positions.push(p);
         if let Some(edges) = &mut self.edges {
             edges.push(NOT_ON_AN_EDGE);
         }
-        Ok(id)
+        Ok(id as u32)
     }
 
     /// A new vertex at the midpoint of cube edge `e` of `cube`.
@@ -374,12 +377,6 @@ impl<L> Out<'_, L> {
             edges[id as usize] = [x as u32, y as u32, z as u32, edge_axis(e) as u32];
         }
         Ok(id)
-    }
-
-    fn triangle(&mut self, t: [u32; 3], pair: [L; 2]) -> u32 {
-        self.atlas.triangles.push(t);
-        self.atlas.pairs.push(pair);
-        (self.atlas.triangles.len() - 1) as u32
     }
 }
 
@@ -428,19 +425,28 @@ pub(super) fn sweep<L: Label>(
     let pad = f64::from(u8::from(params.pad));
     let mut out = Out {
         atlas: &mut atlas,
-        spacing: params.spacing,
-        origin: core::array::from_fn(|a| params.origin[a] - pad * params.spacing[a]),
+        coordinates: core::array::from_fn(|a| {
+            // The world position of padded sample 0 along the axis.
+            let origin = params.origin[a] - pad * params.spacing[a];
+            (4 * cubes[a].start..=4 * cubes[a].end)
+                .map(|q| {
+                    let (cube, quarter) = (q / 4, q % 4);
+                    (origin + (cube as f64 + quarter as f64 / 4.0) * params.spacing[a]) as f32
+                })
+                .collect()
+        }),
+        start: cubes.clone().map(|r| r.start),
         edges: (params.smoothing > 0.0).then(Vec::new),
         pinned: Vec::new(),
     };
-    let table = params.tables.for_mode(params.mode);
-    let mergeable = params.tables.mergeable();
+    let mut binaries = Binaries::new(params);
     let mut patterns = Patterns::default();
     let mut planes = [
         vec![grid.background; nx * ny],
         vec![grid.background; nx * ny],
     ];
-    let mut mask = vec![0u8; nx - 1];
+    // Padded for `changed`; `differs` writes the first `nx − 1`.
+    let mut mask = vec![0u8; (nx - 1).next_multiple_of(8)];
     let mut bottom = [Vec::new(), Vec::new(), Vec::new()];
     let first = layers.start;
     grid.plane(first, xs.clone(), ys.clone(), &mut planes[first % 2]);
@@ -458,7 +464,7 @@ pub(super) fn sweep<L: Label>(
                 &upper[j * nx..][..nx],
                 &upper[(j + 1) * nx..][..nx],
             ];
-            differs(rows, &mut mask);
+            differs(rows, &mut mask[..nx - 1]);
             for i in changed(&mask) {
                 let labels = [
                     rows[0][i],
@@ -479,92 +485,72 @@ pub(super) fn sweep<L: Label>(
                         vertex: out.atlas.positions.len() as u32,
                     });
                 }
-                let (kind, built) = match few_labels(&labels) {
-                    Some(kind) => (grid.by_key(&labels, kind), &[][..]),
-                    None => patterns.get(&labels.map(|l| grid.key(l))),
+                let (kind, nodes, built) = match few_labels(&labels) {
+                    Some(kind) => (grid.by_key(&labels, kind), &[][..], &[][..]),
+                    None => patterns.get(grid, &labels),
                 };
                 match kind {
                     Kind::Uniform => {}
                     Kind::Binary { background, case } => {
                         let class = (cube[0] & 1) | (cube[1] & 1) << 1 | (k & 1) << 2;
-                        let case_at = class * 256 + usize::from(case);
-                        let entry = &table[case_at];
-                        let w = labels[usize::from(background)];
-                        let mut first = 0;
-                        for (n, tri) in entry.tris[..usize::from(entry.count)].iter().enumerate() {
-                            let mut t = [0; 3];
-                            for (v, &e) in t.iter_mut().zip(tri) {
-                                *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
-                            }
-                            let (a, b) = edge_corners(tri[0]);
-                            let x = if labels[usize::from(a)] == w {
-                                labels[usize::from(b)]
-                            } else {
-                                labels[usize::from(a)]
-                            };
-                            let id = out.triangle(t, [x, w]);
-                            if n == 0 {
-                                first = id;
-                            }
+                        let entry = binaries.get(class * 256 + usize::from(case));
+                        let w = labels[usize::from(background & 7)];
+                        // Sixteen slots, indexed by four bits: no bound checks.
+                        let mut v = [0; 16];
+                        for (v, &e) in v.iter_mut().zip(&entry.edges[..usize::from(entry.used)]) {
+                            *v = edge_vertex(&mut ids, &mut out, cube, here, e)?;
                         }
-                        if params.mode == Mode::Steps123 {
-                            continue;
-                        }
-                        for axis in 0..3 {
-                            let ear = entry.ears[axis];
-                            if ear == NO_EAR {
-                                continue;
-                            }
-                            let [back, grey, forward] = entry.tris[usize::from(ear)];
-                            let vertex = *ids.edge(here, grey).0 - 1;
+                        let first = out.atlas.triangles.len() as u32;
+                        // Extended from slices rather than pushed: one capacity check each.
+                        let count = usize::from(entry.count);
+                        out.atlas.triangles.extend(
+                            entry.tris[..count]
+                                .iter()
+                                .map(|tri| tri.map(|s| v[usize::from(s & 15)])),
+                        );
+                        out.atlas.pairs.extend(
+                            entry.other[..count]
+                                .iter()
+                                .map(|&c| [labels[usize::from(c & 7)], w]),
+                        );
+                        for ear in &entry.ears[..usize::from(entry.n_ears)] {
+                            let o = ear.lower;
                             ears.push(Ear {
-                                vertex,
-                                triangle: first + u32::from(ear),
+                                vertex: v[usize::from(ear.slot & 15)],
+                                triangle: first + u32::from(ear.triangle),
                                 background: w,
-                                mergeable: mergeable[case_at] >> axis & 1 == 1,
-                                diagonal: u8::from(in_diagonal_plane(cube, grey, back))
-                                    | u8::from(in_diagonal_plane(cube, grey, forward)) << 1,
-                                lower: edge_lower(cube, grey),
-                                axis,
+                                mergeable: ear.mergeable,
+                                diagonal: ear.diagonal,
+                                lower: core::array::from_fn(|a| cube[a] + usize::from(o[a])),
+                                axis: usize::from(ear.axis),
                             });
                         }
                     }
                     Kind::Junction => {
-                        let mut own = [NONE; 27];
-                        for &(triangle, [a, b]) in built {
-                            let mut t = [0; 3];
-                            for (v, &local) in t.iter_mut().zip(&triangle) {
-                                *v = match local {
-                                    Local::Edge(e) => {
-                                        edge_vertex(&mut ids, &mut out, cube, here, e)?
-                                    }
-                                    Local::Face(f) => shared(ids.face([i, j, k], f), || {
-                                        out.vertex(cube, local.quarters())
-                                    })?,
-                                    Local::Centre | Local::InnerNode(_) | Local::InnerCorner(_) => {
-                                        let s = match local {
-                                            Local::Centre => 0,
-                                            Local::InnerNode(n) => 1 + usize::from(n),
-                                            Local::InnerCorner(c) => 19 + usize::from(c),
-                                            _ => unreachable!(),
-                                        };
-                                        if own[s] == NONE {
-                                            own[s] = out.vertex(cube, local.quarters())?;
-                                        }
-                                        own[s]
-                                    }
-                                };
-                            }
-                            out.triangle(t, [labels[usize::from(a)], labels[usize::from(b)]]);
-                            // A hub's walls and floors are radial from the cube's centre only
-                            // with their nodes at midpoints: smoothing leaves them there.
-                            if out.edges.is_some()
-                                && triangle.iter().any(|l| {
-                                    matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))
-                                })
-                            {
-                                out.pinned.extend(t);
-                            }
+                        // Sixty-four slots, indexed by six bits: no bound checks. A junction uses
+                        // at most 45 (12 edges, 6 faces, the centre, 18 inner nodes, 8 corners).
+                        let mut v = [0; 64];
+                        for (v, &node) in v.iter_mut().zip(nodes) {
+                            *v = match node {
+                                Local::Edge(e) => edge_vertex(&mut ids, &mut out, cube, here, e)?,
+                                Local::Face(f) => shared(ids.face([i, j, k], f), || {
+                                    out.vertex(cube, node.quarters())
+                                })?,
+                                // The centre and the inner vertices are the cube's own.
+                                _ => out.vertex(cube, node.quarters())?,
+                            };
+                        }
+                        let corners = |b: &Built| b.nodes.map(|s| v[usize::from(s & 63)]);
+                        // Extended, as a binary cube's are: one capacity check each.
+                        out.atlas.triangles.extend(built.iter().map(corners));
+                        out.atlas
+                            .pairs
+                            .extend(built.iter().map(|b| b.pair).map(|[x, y]| {
+                                [labels[usize::from(x & 7)], labels[usize::from(y & 7)]]
+                            }));
+                        if out.edges.is_some() {
+                            let pinned = built.iter().filter(|b| b.pinned);
+                            out.pinned.extend(pinned.flat_map(corners));
                         }
                     }
                 }
@@ -587,9 +573,134 @@ pub(super) fn sweep<L: Label>(
     })
 }
 
-/// A junction cube's triangle, with a corner on the side it faces away from and one on the
-/// side it faces toward.
-type Built = ([Local; 3], [u8; 2]);
+/// A binary table entry as the sweep reads it, derived from the entry when first met.
+#[derive(Clone, Copy, Default)]
+struct Binary {
+    /// The entry's edges in order of first use: their vertices, looked up in that order, are
+    /// made in the order the triangles would make them, and each is looked up once.
+    edges: [u8; 12],
+    used: u8,
+    /// Triangles as indices into `edges`.
+    tris: [[u8; 3]; 5],
+    /// Per triangle, the corner of its first edge that is not the background's: its label is
+    /// the one the triangle faces away from.
+    other: [u8; 5],
+    count: u8,
+    /// The ears Step 4 may merge; none in Steps 1–3.
+    ears: [BinaryEar; 3],
+    n_ears: u8,
+    ready: bool,
+}
+
+/// What [`Ear`] takes from a binary entry.
+#[derive(Clone, Copy, Default)]
+struct BinaryEar {
+    /// The ear's triangle in the entry, its grey edge's index in [`Binary::edges`] and lower
+    /// end (from the cube's lower corner).
+    triangle: u8,
+    slot: u8,
+    lower: [u8; 3],
+    axis: u8,
+    mergeable: bool,
+    diagonal: u8,
+}
+
+/// The entries of a mode's table as [`Binary`], each derived when first met.
+struct Binaries {
+    table: &'static [Entry; 2048],
+    mergeable: &'static [u8; 2048],
+    ears: bool,
+    derived: Vec<Binary>,
+}
+
+impl Binaries {
+    fn new<L>(params: &LabelParams<L>) -> Self {
+        Binaries {
+            table: params.tables.for_mode(params.mode),
+            mergeable: params.tables.mergeable(),
+            ears: params.mode != Mode::Steps123,
+            derived: vec![Binary::default(); 2048],
+        }
+    }
+
+    /// Entry `case_at` (`class * 256 + case`).
+    #[inline]
+    fn get(&mut self, case_at: usize) -> &Binary {
+        if !self.derived[case_at].ready {
+            self.derived[case_at] = self.derive(case_at);
+        }
+        &self.derived[case_at]
+    }
+
+    fn derive(&self, case_at: usize) -> Binary {
+        let entry = &self.table[case_at];
+        let case = case_at as u8;
+        let mut b = Binary {
+            count: entry.count,
+            ready: true,
+            ..Binary::default()
+        };
+        let slot = |b: &mut Binary, e: u8| match b.edges[..usize::from(b.used)]
+            .iter()
+            .position(|&f| f == e)
+        {
+            Some(s) => s as u8,
+            None => {
+                b.edges[usize::from(b.used)] = e;
+                b.used += 1;
+                b.used - 1
+            }
+        };
+        for (n, tri) in entry.tris[..usize::from(entry.count)].iter().enumerate() {
+            b.tris[n] = tri.map(|e| slot(&mut b, e));
+            let (c0, c1) = edge_corners(tri[0]);
+            b.other[n] = if case >> c0 & 1 == 1 { c0 } else { c1 };
+        }
+        if self.ears {
+            // The class's parity bits stand for the cube's: diagonals depend on nothing else.
+            let class = case_at / 256;
+            let cube = [class & 1, class >> 1 & 1, class >> 2 & 1];
+            for axis in 0..3 {
+                let ear = entry.ears[axis];
+                if ear == NO_EAR {
+                    continue;
+                }
+                let [back, grey, forward] = entry.tris[usize::from(ear)];
+                b.ears[usize::from(b.n_ears)] = BinaryEar {
+                    triangle: ear,
+                    slot: slot(&mut b, grey),
+                    lower: EDGE_LOWER[usize::from(grey)].map(|o| o as u8),
+                    axis: axis as u8,
+                    mergeable: self.mergeable[case_at] >> axis & 1 == 1,
+                    diagonal: u8::from(in_diagonal_plane(cube, grey, back))
+                        | u8::from(in_diagonal_plane(cube, grey, forward)) << 1,
+                };
+                b.n_ears += 1;
+            }
+        }
+        b
+    }
+}
+
+/// A junction cube's triangle: its vertices as indices into its pattern's nodes, a corner on
+/// the side it faces away from and one on the side it faces toward, and whether smoothing
+/// leaves its vertices where they are made (a hub's walls and floors are radial from the
+/// cube's centre only with their nodes at midpoints).
+#[derive(Clone, Copy)]
+struct Built {
+    nodes: [u8; 3],
+    pair: [u8; 2],
+    pinned: bool,
+}
+
+/// A pattern's construction: its kind, and for a junction the ranges of its nodes (in
+/// `Patterns::nodes`) and triangles (in `Patterns::triangles`).
+#[derive(Clone, Copy)]
+struct Construction {
+    kind: Kind,
+    nodes: (usize, usize),
+    triangles: (usize, usize),
+}
 
 /// The constructions of cubes with three or more labels met so far, by the order pattern of
 /// their corners' labels: a segmentation has few patterns, and building one takes thousands of
@@ -597,61 +708,131 @@ type Built = ([Local; 3], [u8; 2]);
 /// pattern are built alike.
 #[derive(Default)]
 struct Patterns {
-    /// Pattern → its kind and its triangles' range in `triangles`.
-    index: BTreeMap<u32, (Kind, usize, usize)>,
-    /// Triangles with, per triangle, a corner on the side it faces away from and one on the
-    /// side it faces toward.
+    index: HashMap<u32, Construction>,
+    /// Per junction pattern, the vertices its triangles use, in order of first use: a cube
+    /// makes or finds each once, in the order its triangles would.
+    nodes: Vec<Local>,
     triangles: Vec<Built>,
     built: Junction,
 }
 
 impl Patterns {
-    fn get<K: Ord + Copy>(&mut self, keys: &[K; 8]) -> (Kind, &[Built]) {
-        let mut sorted = *keys;
-        sorted.sort_unstable();
-        let mut pattern = 0u32;
-        for (c, key) in keys.iter().enumerate() {
-            let rank = sorted[..sorted.partition_point(|k| k < key)]
-                .windows(2)
-                .filter(|w| w[0] != w[1])
-                .count()
-                + usize::from(sorted[0] < *key);
-            pattern |= (rank as u32) << (3 * c);
-        }
-        let (kind, start, len) = match self.index.get(&pattern) {
+    /// The construction of a cube of `labels` on `grid`.
+    fn get<L: Label>(
+        &mut self,
+        grid: &Padded<'_, L>,
+        labels: &[L; 8],
+    ) -> (Kind, &[Local], &[Built]) {
+        let pattern = pattern(labels, grid.background);
+        let found = match self.index.get(&pattern) {
             Some(&found) => found,
             None => {
+                let keys = &labels.map(|l| grid.key(l));
                 let kind = classify(keys);
-                let start = self.triangles.len();
+                let (nodes, triangles) = (self.nodes.len(), self.triangles.len());
                 if kind == Kind::Junction {
                     junction(keys, &mut self.built);
                     let b = &self.built;
-                    self.triangles
-                        .extend((0..b.len).map(|n| (b.triangles[n], b.pairs[n])));
+                    for n in 0..b.len {
+                        let triangle = b.triangles[n].map(|local| {
+                            let mine = &mut self.nodes;
+                            let s = match mine[nodes..].iter().position(|&l| l == local) {
+                                Some(s) => s,
+                                None => {
+                                    mine.push(local);
+                                    mine.len() - 1 - nodes
+                                }
+                            };
+                            s as u8
+                        });
+                        self.triangles.push(Built {
+                            nodes: triangle,
+                            pair: b.pairs[n],
+                            pinned: b.triangles[n]
+                                .iter()
+                                .any(|l| matches!(l, Local::InnerNode(_) | Local::InnerCorner(_))),
+                        });
+                    }
                 }
-                let entry = (kind, start, self.triangles.len() - start);
-                self.index.insert(pattern, entry);
-                entry
+                let found = Construction {
+                    kind,
+                    nodes: (nodes, self.nodes.len()),
+                    triangles: (triangles, self.triangles.len()),
+                };
+                self.index.insert(pattern, found);
+                found
             }
         };
-        (kind, &self.triangles[start..start + len])
+        (
+            found.kind,
+            &self.nodes[found.nodes.0..found.nodes.1],
+            &self.triangles[found.triangles.0..found.triangles.1],
+        )
     }
 }
 
-/// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
-fn changed(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
-    mask.chunks(8).enumerate().flat_map(|(n, chunk)| {
-        let mut bytes = [0u8; 8];
-        bytes[..chunk.len()].copy_from_slice(chunk);
-        let mut word = u64::from_le_bytes(bytes);
-        core::iter::from_fn(move || {
-            let k = word.trailing_zeros() / 8;
-            (word != 0).then(|| {
-                word &= !(0xFF << (8 * k));
-                8 * n + k as usize
-            })
-        })
+/// The order pattern of a cube's keys ([`Padded::key`]): three bits per corner, its key's rank
+/// among the distinct keys. From the 28 comparisons of pairs of labels, without a sort: a
+/// corner's rank counts the smaller keys' first corners. Keys order labels as the labels do,
+/// but for the background, which comes first: comparing labels is cheaper than comparing keys.
+#[inline]
+fn pattern<L: Ord + Copy>(labels: &[L; 8], background: L) -> u32 {
+    let mut smaller = [0u32; 8];
+    let mut firsts = 0xFFu32;
+    let mut backgrounds = 0u32;
+    for c in 0..8 {
+        backgrounds |= u32::from(labels[c] == background) << c;
+        for d in c + 1..8 {
+            match labels[d].cmp(&labels[c]) {
+                core::cmp::Ordering::Less => smaller[c] |= 1 << d,
+                core::cmp::Ordering::Greater => smaller[d] |= 1 << c,
+                core::cmp::Ordering::Equal => firsts &= !(1 << d),
+            }
+        }
+    }
+    (0..8).fold(0, |p, c| {
+        let below = if backgrounds >> c & 1 == 1 {
+            0
+        } else {
+            smaller[c] & !backgrounds | backgrounds
+        };
+        p | (below & firsts).count_ones() << (3 * c)
     })
+}
+
+/// The cubes a row's mask marks: most cubes hold one label, and are skipped eight at a time.
+/// The mask is padded with zeros to a multiple of eight, so each word is one load.
+fn changed(mask: &[u8]) -> Changed<'_> {
+    Changed {
+        mask,
+        next: 0,
+        word: 0,
+    }
+}
+
+/// The iterator of [`changed`]: a word of the mask and where the next starts, which is less
+/// state for the sweep's loop to keep than a chain of adapters.
+struct Changed<'a> {
+    mask: &'a [u8],
+    next: usize,
+    word: u64,
+}
+
+impl Iterator for Changed<'_> {
+    type Item = usize;
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.word == 0 {
+            let bytes = self.mask.get(self.next..self.next + 8)?;
+            self.word = u64::from_le_bytes(bytes.try_into().unwrap_or_default());
+            self.next += 8;
+        }
+        let k = self.word.trailing_zeros() as usize / 8;
+        // Each byte is 0 or 1: clearing the lowest bit set clears its byte.
+        self.word &= self.word - 1;
+        Some(self.next - 8 + k)
+    }
 }
 
 /// Per cube of a row, 1 if its eight corners (`rows`: y and y + 1 at z, then at z + 1) do not
@@ -702,7 +883,8 @@ const EDGE_LOWER: [[usize; 3]; 12] = {
 };
 
 /// The vertex on cube edge `e`, made at its midpoint when first used.
-#[inline]
+// Always inlined, as `shared` is: out of line, the call costs more than the lookup.
+#[inline(always)]
 fn edge_vertex<L>(
     ids: &mut Ids,
     out: &mut Out<'_, L>,
@@ -724,5 +906,34 @@ fn in_diagonal_plane(cube: [usize; 3], grey: u8, e: u8) -> bool {
         2 if g[2].is_multiple_of(2) => axis != 0 && p[0] == g[0],
         2 => axis != 1 && p[1] == g[1],
         _ => axis != 2 && p[2] == g[2],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`pattern`] is each corner's rank among the distinct keys, as sorting the keys gives it,
+    /// for every labelling of a cube with four labels, the background each of them in turn.
+    #[test]
+    fn pattern_ranks_keys() {
+        for background in 0u8..4 {
+            for n in 0..4u32.pow(8) {
+                let labels: [u8; 8] = core::array::from_fn(|c| (n >> (2 * c) & 3) as u8);
+                let keys = labels.map(|l| (l != background, l));
+                let mut distinct = keys.to_vec();
+                distinct.sort_unstable();
+                distinct.dedup();
+                let sorted = (0..8).fold(0, |p, c| {
+                    let rank = distinct.iter().position(|k| *k == keys[c]).unwrap();
+                    p | (rank as u32) << (3 * c)
+                });
+                assert_eq!(
+                    pattern(&labels, background),
+                    sorted,
+                    "{labels:?}, {background}"
+                );
+            }
+        }
     }
 }

@@ -98,25 +98,28 @@ pub fn classify<K: Ord + Copy>(keys: &[K; 8]) -> Kind {
 /// the smaller label is the background. `None` for three or more.
 #[inline]
 pub fn few_labels<K: Ord + Copy>(keys: &[K; 8]) -> Option<Kind> {
+    // Masks of comparisons rather than a loop that stops at the third label: no branch per
+    // corner, and most cubes asked have two labels.
     let first = keys[0];
-    let mut other = None;
-    let mut two = true;
-    for &k in &keys[1..] {
-        if k != first {
-            match other {
-                None => other = Some(k),
-                Some(o) if o == k => {}
-                Some(_) => {
-                    two = false;
-                    break;
-                }
-            }
-        }
-    }
-    let Some(other) = other else {
+    let differ = (1..8).fold(0u8, |m, c| m | u8::from(keys[c] != first) << c);
+    if differ == 0 {
         return Some(Kind::Uniform);
-    };
-    two.then(|| binary(keys, first.min(other)))
+    }
+    let o = differ.trailing_zeros() as u8;
+    let other = keys[usize::from(o)];
+    let neither = (1..8).fold(0u8, |m, c| m | u8::from(keys[c] != other) << c) & differ;
+    // The smaller label is the background, as in `binary`.
+    (neither == 0).then_some(if first < other {
+        Kind::Binary {
+            background: 0,
+            case: differ,
+        }
+    } else {
+        Kind::Binary {
+            background: o,
+            case: !differ,
+        }
+    })
 }
 
 /// [`classify`] for three or more labels.
