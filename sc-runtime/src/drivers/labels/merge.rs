@@ -13,7 +13,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::sweep::{Ear, Padded};
-use super::{Atlas, Label, LabelParams};
+use super::{Atlas, Label, LabelParams, chunks};
 use crate::Mode;
 
 /// Merges what may merge among `ears`, then drops the vertices and triangles merged away;
@@ -177,127 +177,56 @@ fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> b
 }
 
 /// Drops the marked vertices and triangles, renumbering the vertices in their order; returns
-/// the new ids. Runs in chunks, on threads unless one was asked for: each chunk keeps its own
-/// items at its start, then the chunks' kept runs are moved down into place in order.
-fn compact<L: Copy + Send + Sync>(
+/// the new ids. Runs in chunks, on threads unless one was asked for: each chunk counts what it
+/// keeps, then copies it to its place in new lists, those before it having kept the rest.
+fn compact<L: Label>(
     atlas: &mut Atlas<L>,
     gone_vertex: &[bool],
     gone_triangle: &[bool],
     threads: usize,
 ) -> Vec<u32> {
-    let chunk = |n: usize| match threads {
-        1 => n.max(1),
-        _ => n.div_ceil(64).max(1 << 10),
-    };
     // Vertices: each chunk's first new id is the number kept before it.
-    let size = chunk(gone_vertex.len());
-    let before = offsets(&map_chunks(gone_vertex, size, |gone| {
-        gone.iter().filter(|&&g| !g).count()
-    }));
-    let mut new_id = vec![u32::MAX; gone_vertex.len()];
-    let kept = map_chunks_mut(
-        &mut atlas.positions,
-        &mut new_id,
-        gone_vertex,
-        size,
-        |k, p, ids, gone| {
-            let mut n = 0;
-            for v in 0..p.len() {
-                if !gone[v] {
-                    ids[v] = (before[k] + n) as u32;
-                    p[n] = p[v];
-                    n += 1;
-                }
-            }
-            n
-        },
-    );
-    gather(&mut atlas.positions, size, &kept);
-    let size = chunk(gone_triangle.len());
-    let (triangles, pairs) = (&mut atlas.triangles, &mut atlas.pairs);
-    let kept = map_chunks_mut(triangles, pairs, gone_triangle, size, |_, t, p, gone| {
+    let size = chunks::size(gone_vertex.len(), threads);
+    let kept = chunks::kept(gone_vertex, size);
+    // Zeroed lists are fresh pages, written first by the chunks, on their threads.
+    let mut new_id = vec![0u32; gone_vertex.len()];
+    let mut positions = vec![[0f32; 3]; kept.iter().sum()];
+    let jobs = atlas.positions.chunks(size).zip(gone_vertex.chunks(size));
+    let jobs = jobs.zip(new_id.chunks_mut(size));
+    let jobs = jobs.zip(chunks::split(&mut positions, &kept));
+    let jobs = jobs.zip(chunks::offsets(&kept)).collect();
+    chunks::map(jobs, |((((p, gone), ids), out), first)| {
         let mut n = 0;
-        for i in 0..t.len() {
-            if !gone[i] {
-                t[n] = t[i].map(|v| new_id[v as usize]);
-                p[n] = p[i];
+        for ((p, &gone), id) in p.iter().zip(gone).zip(ids) {
+            if gone {
+                *id = u32::MAX;
+            } else {
+                *id = (first + n) as u32;
+                out[n] = *p;
                 n += 1;
             }
         }
-        n
     });
-    gather(&mut atlas.triangles, size, &kept);
-    gather(&mut atlas.pairs, size, &kept);
+    atlas.positions = positions;
+    let size = chunks::size(gone_triangle.len(), threads);
+    let kept = chunks::kept(gone_triangle, size);
+    let mut triangles = vec![[0u32; 3]; kept.iter().sum()];
+    let mut pairs = vec![[L::ZERO; 2]; triangles.len()];
+    let jobs = atlas.triangles.chunks(size).zip(atlas.pairs.chunks(size));
+    let jobs = jobs.zip(gone_triangle.chunks(size));
+    let jobs = jobs.zip(chunks::split(&mut triangles, &kept));
+    let jobs = jobs.zip(chunks::split(&mut pairs, &kept)).collect();
+    chunks::map(jobs, |((((t, p), gone), out_t), out_p)| {
+        let mut n = 0;
+        for ((t, p), &gone) in t.iter().zip(p).zip(gone) {
+            if !gone {
+                out_t[n] = t.map(|v| new_id[v as usize]);
+                out_p[n] = *p;
+                n += 1;
+            }
+        }
+    });
+    atlas.triangles = triangles;
+    atlas.pairs = pairs;
     new_id
-}
-
-/// The running sums before each count.
-fn offsets(counts: &[usize]) -> Vec<usize> {
-    counts
-        .iter()
-        .scan(0, |sum, &c| {
-            let at = *sum;
-            *sum += c;
-            Some(at)
-        })
-        .collect()
-}
-
-/// Moves the first `kept[k]` items of each chunk `k` of `size` items down after the previous
-/// chunks' kept items, and drops the rest.
-fn gather<T: Copy>(items: &mut Vec<T>, size: usize, kept: &[usize]) {
-    let mut to = 0;
-    for (k, &n) in kept.iter().enumerate() {
-        items.copy_within(k * size..k * size + n, to);
-        to += n;
-    }
-    items.truncate(to);
-}
-
-/// `f` of each chunk of `size` flags.
-#[cfg(feature = "std")]
-fn map_chunks(flags: &[bool], size: usize, f: impl Fn(&[bool]) -> usize + Sync) -> Vec<usize> {
-    use rayon::prelude::*;
-    flags.par_chunks(size).map(&f).collect()
-}
-
-/// `f` of each chunk of `size` flags.
-#[cfg(not(feature = "std"))]
-fn map_chunks(flags: &[bool], size: usize, f: impl Fn(&[bool]) -> usize) -> Vec<usize> {
-    flags.chunks(size).map(f).collect()
-}
-
-/// `f(k, a, b, flags)` of each chunk `k` of `size` items of the three lists alike.
-#[cfg(feature = "std")]
-fn map_chunks_mut<A: Send, B: Send>(
-    a: &mut [A],
-    b: &mut [B],
-    flags: &[bool],
-    size: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &[bool]) -> usize + Sync,
-) -> Vec<usize> {
-    use rayon::prelude::*;
-    a.par_chunks_mut(size)
-        .zip(b.par_chunks_mut(size))
-        .zip(flags.par_chunks(size))
-        .enumerate()
-        .map(|(k, ((a, b), g))| f(k, a, b, g))
-        .collect()
-}
-
-/// `f(k, a, b, flags)` of each chunk `k` of `size` items of the three lists alike.
-#[cfg(not(feature = "std"))]
-fn map_chunks_mut<A, B>(
-    a: &mut [A],
-    b: &mut [B],
-    flags: &[bool],
-    size: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &[bool]) -> usize,
-) -> Vec<usize> {
-    a.chunks_mut(size)
-        .zip(b.chunks_mut(size))
-        .zip(flags.chunks(size))
-        .enumerate()
-        .map(|(k, ((a, b), g))| f(k, a, b, g))
-        .collect()
 }

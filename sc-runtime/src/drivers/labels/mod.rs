@@ -15,6 +15,7 @@ use hashbrown::{HashMap, HashSet};
 use crate::{Error, Mesh, Mode, Stats, Volume};
 
 mod blocks;
+mod chunks;
 mod join;
 mod merge;
 mod smooth;

@@ -1,0 +1,59 @@
+//! Work cut into chunks, each chunk writing its own part of the output: with `std` the chunks
+//! run on the current Rayon pool, without it one after another. The output does not depend on
+//! how the work was cut, so the atlas is the same for any number of threads.
+
+use alloc::vec::Vec;
+
+/// The items in a chunk of `n`: all of them on one thread, else about 64 chunks, so that
+/// threads slowed by other work still share it out, but not so small that a chunk costs more
+/// to hand out than to do.
+pub(super) fn size(n: usize, threads: usize) -> usize {
+    match threads {
+        1 => n.max(1),
+        _ => n.div_ceil(64).max(1 << 10),
+    }
+}
+
+/// `f` of each job, in order.
+#[cfg(feature = "std")]
+pub(super) fn map<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync + Send) -> Vec<R> {
+    use rayon::prelude::*;
+    jobs.into_par_iter().map(f).collect()
+}
+
+/// `f` of each job, in order.
+#[cfg(not(feature = "std"))]
+pub(super) fn map<T, R>(jobs: Vec<T>, f: impl Fn(T) -> R) -> Vec<R> {
+    jobs.into_iter().map(f).collect()
+}
+
+/// The running sums before each count.
+pub(super) fn offsets(counts: &[usize]) -> Vec<usize> {
+    counts
+        .iter()
+        .scan(0, |sum, &c| {
+            let at = *sum;
+            *sum += c;
+            Some(at)
+        })
+        .collect()
+}
+
+/// `out` cut into consecutive parts of `lengths` (which sum to at most its length).
+pub(super) fn split<'a, T>(mut out: &'a mut [T], lengths: &[usize]) -> Vec<&'a mut [T]> {
+    lengths
+        .iter()
+        .map(|&n| {
+            let (part, rest) = core::mem::take(&mut out).split_at_mut(n);
+            out = rest;
+            part
+        })
+        .collect()
+}
+
+/// How many of each chunk of `size` flags are false: the items a chunk keeps.
+pub(super) fn kept(gone: &[bool], size: usize) -> Vec<usize> {
+    map(gone.chunks(size).collect(), |gone| {
+        gone.iter().filter(|&&g| !g).count()
+    })
+}
