@@ -14,10 +14,13 @@ pub(super) fn size(n: usize, threads: usize) -> usize {
     }
 }
 
-/// `f` of each job, in order.
+/// `f` of each job, in order; one job runs on this thread, not handed to the pool.
 #[cfg(feature = "std")]
 pub(super) fn map<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync + Send) -> Vec<R> {
     use rayon::prelude::*;
+    if jobs.len() <= 1 {
+        return jobs.into_iter().map(f).collect();
+    }
     jobs.into_par_iter().map(f).collect()
 }
 
