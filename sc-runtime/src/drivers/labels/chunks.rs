@@ -30,6 +30,26 @@ pub(super) fn map<T, R>(jobs: Vec<T>, f: impl Fn(T) -> R) -> Vec<R> {
     jobs.into_iter().map(f).collect()
 }
 
+/// `f` of each of `0..n`, in order, on threads unless one was asked for.
+#[cfg(feature = "std")]
+pub(super) fn fill<T: Send>(
+    n: usize,
+    threads: usize,
+    f: impl Fn(usize) -> T + Sync + Send,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    if threads == 1 {
+        return (0..n).map(f).collect();
+    }
+    (0..n).into_par_iter().map(f).collect()
+}
+
+/// `f` of each of `0..n`, in order.
+#[cfg(not(feature = "std"))]
+pub(super) fn fill<T>(n: usize, _threads: usize, f: impl Fn(usize) -> T) -> Vec<T> {
+    (0..n).map(f).collect()
+}
+
 /// The running sums before each count.
 pub(super) fn offsets(counts: &[usize]) -> Vec<usize> {
     counts
@@ -52,11 +72,4 @@ pub(super) fn split<'a, T>(mut out: &'a mut [T], lengths: &[usize]) -> Vec<&'a m
             part
         })
         .collect()
-}
-
-/// How many of each chunk of `size` flags are false: the items a chunk keeps.
-pub(super) fn kept(gone: &[bool], size: usize) -> Vec<usize> {
-    map(gone.chunks(size).collect(), |gone| {
-        gone.iter().filter(|&&g| !g).count()
-    })
 }

@@ -12,102 +12,138 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use core::sync::atomic::Ordering::Relaxed;
+use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32};
+
 use super::sweep::{Ear, Padded};
 use super::{Atlas, Label, LabelParams, chunks};
 use crate::Mode;
 
+/// The outcome of Step 4 on an atlas.
+pub(super) struct Merged {
+    /// Each old vertex's new id, `u32::MAX` if it was merged away.
+    pub kept: Vec<u32>,
+    /// Each old triangle's fate (see [`KEEP`]).
+    fate: Vec<AtomicU32>,
+}
+
+impl Merged {
+    /// Whether old triangle `t` was merged away.
+    pub fn gone(&self, t: usize) -> bool {
+        self.fate[t].load(Relaxed) == GONE
+    }
+}
+
+/// A triangle's fate, [`KEEP`], [`GONE`], or `REPLACED + 2g + r`: replaced by the `r`-th
+/// triangle of group `g`'s merged pair. Groups are fewer than a quarter of the triangles, so
+/// this fits.
+const KEEP: u32 = 0;
+const GONE: u32 = 1;
+const REPLACED: u32 = 2;
+
 /// Merges what may merge among `ears`, then drops the vertices and triangles merged away;
-/// returns, if any ear was looked at, each old vertex's new id (`u32::MAX` if dropped) and
-/// which old triangles were dropped.
+/// returns, if any ear was looked at, what became of each old vertex and triangle.
 pub(super) fn merge<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
     ears: Vec<Ear<L>>,
     atlas: &mut Atlas<L>,
-) -> Option<(Vec<u32>, Vec<bool>)> {
+) -> Option<Merged> {
     if ears.is_empty() {
         return None;
     }
-    let mut gone_vertex = vec![false; atlas.positions.len()];
-    let mut gone_triangle = vec![false; atlas.triangles.len()];
-    let groups = around(&ears, atlas.positions.len());
-    // Each ear is one grey vertex's, so the decisions are independent: made on threads, applied
-    // in order.
-    let decide = |group: &[u32; 4]| {
-        let [a, b, c, d] = group.map(|e| &ears[e as usize]);
+    let threads = params.threads;
+    let groups = around(&ears, atlas.positions.len(), threads);
+    // Each ear is one grey vertex's, so the decisions are independent: made on threads.
+    let decide = |g: usize| {
+        let [a, b, c, d] = groups[g].map(|e| &ears[e as usize]);
         let w = a.background;
         let allowed = [b, c, d].iter().all(|e| e.background == w)
             && (params.mode == Mode::Paper
                 || [a, b, c, d].iter().all(|e| e.mergeable) && !blocks(grid, a.lower, a.axis, w));
         allowed.then(|| quad(atlas, [a, b, c, d])).flatten()
     };
-    let decisions: Vec<Option<[[u32; 3]; 2]>> = decide_all(&groups, decide, params.threads);
-    for (group, decision) in groups.iter().zip(decisions) {
-        let [a, b, c, d] = group.map(|e| &ears[e as usize]);
-        let Some([first, second]) = decision else {
-            atlas.stats.blocked += 1;
-            continue;
-        };
-        atlas.triangles[a.triangle as usize] = first;
-        atlas.triangles[b.triangle as usize] = second;
-        gone_triangle[c.triangle as usize] = true;
-        gone_triangle[d.triangle as usize] = true;
-        gone_vertex[a.vertex as usize] = true;
-        atlas.stats.merged += 1;
-    }
-    let kept = compact(atlas, &gone_vertex, &gone_triangle, params.threads);
-    Some((kept, gone_triangle))
-}
-
-/// `decide` for every group, on threads unless one was asked for.
-#[cfg(feature = "std")]
-fn decide_all<T: Send>(
-    groups: &[[u32; 4]],
-    decide: impl Fn(&[u32; 4]) -> T + Sync,
-    threads: usize,
-) -> Vec<T> {
-    use rayon::prelude::*;
-    if threads == 1 {
-        groups.iter().map(decide).collect()
-    } else {
-        groups.par_iter().map(&decide).collect()
-    }
-}
-
-/// `decide` for every group.
-#[cfg(not(feature = "std"))]
-fn decide_all<T>(groups: &[[u32; 4]], decide: impl Fn(&[u32; 4]) -> T, _threads: usize) -> Vec<T> {
-    groups.iter().map(decide).collect()
+    let decisions: Vec<Option<[[u32; 3]; 2]>> = chunks::fill(groups.len(), threads, decide);
+    // Applied on threads too, as marks: each triangle is one ear's at most, each ear one
+    // group's, so no two groups mark the same triangle or vertex.
+    let fate = chunks::fill(atlas.triangles.len(), threads, |_| AtomicU32::new(KEEP));
+    let gone_vertex = chunks::fill(atlas.positions.len(), threads, |_| AtomicBool::new(false));
+    let size = chunks::size(groups.len(), threads);
+    let jobs = groups.chunks(size).zip(decisions.chunks(size));
+    let merged = chunks::map(jobs.enumerate().collect(), |(k, (groups, decisions))| {
+        let mut merged = 0;
+        for (i, (group, decision)) in groups.iter().zip(decisions).enumerate() {
+            if decision.is_some() {
+                let [a, b, c, d] = group.map(|e| &ears[e as usize]);
+                let replaced = REPLACED + 2 * (k * size + i) as u32;
+                fate[a.triangle as usize].store(replaced, Relaxed);
+                fate[b.triangle as usize].store(replaced + 1, Relaxed);
+                fate[c.triangle as usize].store(GONE, Relaxed);
+                fate[d.triangle as usize].store(GONE, Relaxed);
+                gone_vertex[a.vertex as usize].store(true, Relaxed);
+                merged += 1;
+            }
+        }
+        merged
+    })
+    .into_iter()
+    .sum::<u64>();
+    atlas.stats.merged += merged;
+    atlas.stats.blocked += groups.len() as u64 - merged;
+    let kept = compact(atlas, &gone_vertex, &fate, &decisions, threads);
+    Some(Merged { kept, fate })
 }
 
 /// The ears of each grey vertex with four, by ascending vertex, each group in the order the ears
-/// came: a counting sort, the ears being many and their vertices dense.
-fn around<L>(ears: &[Ear<L>], vertices: usize) -> Vec<[u32; 4]> {
-    let mut count = vec![0u8; vertices];
-    for ear in ears {
-        let c = &mut count[ear.vertex as usize];
-        *c = c.saturating_add(1);
-    }
+/// came: a counting sort, the ears being many and their vertices dense, in chunks on threads
+/// unless one was asked for.
+fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> Vec<[u32; 4]> {
+    // At most four ears a vertex, one per cube around its grid edge: a byte counts them.
+    let count = chunks::fill(vertices, threads, |_| AtomicU8::new(0));
+    let size = chunks::size(ears.len(), threads);
+    chunks::map(ears.chunks(size).collect(), |ears| {
+        for ear in ears {
+            count[ear.vertex as usize].fetch_add(1, Relaxed);
+        }
+    });
     // Fewer than four ears: a cube around the edge is not binary, or lies outside the grid.
-    let mut slot = vec![u32::MAX; vertices];
-    let mut groups = 0u32;
-    for (s, &c) in slot.iter_mut().zip(&count) {
-        if c == 4 {
-            *s = groups;
-            groups += 1;
+    // Each chunk of vertices numbers its groups after those of the chunks before.
+    let four = |c: &AtomicU8| c.load(Relaxed) == 4;
+    let vsize = chunks::size(vertices, threads);
+    let fours = chunks::map(count.chunks(vsize).collect(), |c| {
+        c.iter().filter(|&c| four(c)).count()
+    });
+    // Per vertex its group plus one, 0 for none.
+    let mut slot = vec![0u32; vertices];
+    let jobs = count.chunks(vsize).zip(slot.chunks_mut(vsize));
+    let jobs = jobs.zip(chunks::offsets(&fours)).collect();
+    chunks::map(jobs, |((count, slot), before)| {
+        let mut g = before as u32;
+        for (c, s) in count.iter().zip(slot) {
+            if four(c) {
+                g += 1;
+                *s = g;
+            }
         }
-    }
-    let mut out = vec![[0u32; 4]; groups as usize];
-    let mut filled = vec![0u8; groups as usize];
-    for (n, ear) in ears.iter().enumerate() {
-        let g = slot[ear.vertex as usize];
-        if g != u32::MAX {
-            let f = &mut filled[g as usize];
-            out[g as usize][usize::from(*f)] = n as u32;
-            *f += 1;
+    });
+    let groups = fours.iter().sum::<usize>();
+    // Each ear takes a place in its group as the count comes down; the places are then put
+    // back in the order the ears came.
+    let out = chunks::fill(4 * groups, threads, |_| AtomicU32::new(0));
+    chunks::map(ears.chunks(size).enumerate().collect(), |(k, ears)| {
+        for (i, ear) in ears.iter().enumerate() {
+            let v = ear.vertex as usize;
+            if slot[v] != 0 {
+                let place = usize::from(count[v].fetch_sub(1, Relaxed)) - 1;
+                out[4 * (slot[v] as usize - 1) + place].store((k * size + i) as u32, Relaxed);
+            }
         }
-    }
-    out
+    });
+    chunks::fill(groups, threads, |g| {
+        let mut group: [u32; 4] = core::array::from_fn(|i| out[4 * g + i].load(Relaxed));
+        group.sort_unstable();
+        group
+    })
 }
 
 /// The two triangles replacing the four ears `[back, grey, forward]` around a grey vertex, split
@@ -176,18 +212,23 @@ fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> b
     }
 }
 
-/// Drops the marked vertices and triangles, renumbering the vertices in their order; returns
-/// the new ids. Runs in chunks, on threads unless one was asked for: each chunk counts what it
-/// keeps, then copies it to its place in new lists, those before it having kept the rest.
+/// Drops the vertices marked gone and the triangles whose fate is [`GONE`], puts the
+/// merged pairs in place of the triangles they replace, and renumbers the vertices in their
+/// order; returns the new ids. Runs in chunks, on threads unless one was asked for: each chunk
+/// counts what it keeps, then copies it to its place in new lists, after what those before it
+/// kept.
 fn compact<L: Label>(
     atlas: &mut Atlas<L>,
-    gone_vertex: &[bool],
-    gone_triangle: &[bool],
+    gone_vertex: &[AtomicBool],
+    fate: &[AtomicU32],
+    decisions: &[Option<[[u32; 3]; 2]>],
     threads: usize,
 ) -> Vec<u32> {
     // Vertices: each chunk's first new id is the number kept before it.
     let size = chunks::size(gone_vertex.len(), threads);
-    let kept = chunks::kept(gone_vertex, size);
+    let kept = chunks::map(gone_vertex.chunks(size).collect(), |gone| {
+        gone.iter().filter(|g| !g.load(Relaxed)).count()
+    });
     // Zeroed lists are fresh pages, written first by the chunks, on their threads.
     let mut new_id = vec![0u32; gone_vertex.len()];
     let mut positions = vec![[0f32; 3]; kept.iter().sum()];
@@ -197,8 +238,8 @@ fn compact<L: Label>(
     let jobs = jobs.zip(chunks::offsets(&kept)).collect();
     chunks::map(jobs, |((((p, gone), ids), out), first)| {
         let mut n = 0;
-        for ((p, &gone), id) in p.iter().zip(gone).zip(ids) {
-            if gone {
+        for ((p, gone), id) in p.iter().zip(gone).zip(ids) {
+            if gone.load(Relaxed) {
                 *id = u32::MAX;
             } else {
                 *id = (first + n) as u32;
@@ -208,22 +249,30 @@ fn compact<L: Label>(
         }
     });
     atlas.positions = positions;
-    let size = chunks::size(gone_triangle.len(), threads);
-    let kept = chunks::kept(gone_triangle, size);
+    let size = chunks::size(fate.len(), threads);
+    let kept = chunks::map(fate.chunks(size).collect(), |fate| {
+        fate.iter().filter(|f| f.load(Relaxed) != GONE).count()
+    });
     let mut triangles = vec![[0u32; 3]; kept.iter().sum()];
     let mut pairs = vec![[L::ZERO; 2]; triangles.len()];
     let jobs = atlas.triangles.chunks(size).zip(atlas.pairs.chunks(size));
-    let jobs = jobs.zip(gone_triangle.chunks(size));
+    let jobs = jobs.zip(fate.chunks(size));
     let jobs = jobs.zip(chunks::split(&mut triangles, &kept));
     let jobs = jobs.zip(chunks::split(&mut pairs, &kept)).collect();
-    chunks::map(jobs, |((((t, p), gone), out_t), out_p)| {
+    chunks::map(jobs, |((((t, p), fate), out_t), out_p)| {
         let mut n = 0;
-        for ((t, p), &gone) in t.iter().zip(p).zip(gone) {
-            if !gone {
-                out_t[n] = t.map(|v| new_id[v as usize]);
-                out_p[n] = *p;
-                n += 1;
-            }
+        for ((t, p), fate) in t.iter().zip(p).zip(fate) {
+            let t = match fate.load(Relaxed) {
+                GONE => continue,
+                KEEP => t,
+                f => {
+                    let (g, r) = ((f - REPLACED) as usize / 2, (f - REPLACED) as usize % 2);
+                    decisions[g].as_ref().map_or(t, |pair| &pair[r])
+                }
+            };
+            out_t[n] = t.map(|v| new_id[v as usize]);
+            out_p[n] = *p;
+            n += 1;
         }
     });
     atlas.triangles = triangles;

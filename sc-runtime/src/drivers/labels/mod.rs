@@ -133,8 +133,8 @@ pub fn extract_labels<L: Label>(
         let (mut atlas, ears, mut edges, mut pinned) = join::join(pieces);
         atlas.stats.v13 = atlas.positions.len() as u64;
         atlas.stats.t13 = atlas.triangles.len() as u64;
-        if let Some((kept, _)) = merge::merge(&grid, params, ears, &mut atlas) {
-            renumber(&mut edges, &mut pinned, &kept);
+        if let Some(merged) = merge::merge(&grid, params, ears, &mut atlas) {
+            renumber(&mut edges, &mut pinned, &merged.kept);
         }
         if params.smoothing > 0.0 {
             smooth::place(&grid, params, &mut atlas.positions, &edges, &pinned);
