@@ -1,7 +1,6 @@
 //! Joining the pieces of a label sweep: the vertices of the plane two pieces share were made
 //! by both, and are kept once, with the lower piece's number.
 
-use alloc::vec;
 use alloc::vec::Vec;
 
 use super::sweep::{Ear, Edge, Piece};
@@ -37,7 +36,7 @@ pub(super) fn join<L: Label>(
     let mut shared = top;
     for piece in rest {
         // Per vertex of the piece, its joined id plus one where the lower piece made it, else 0.
-        let mut number = vec![0u32; piece.atlas.positions.len()];
+        let mut number = chunks::fill(piece.atlas.positions.len(), 0, |_| 0u32);
         for (mine, theirs) in piece.bottom.iter().zip(&shared) {
             for (&m, &t) in mine.iter().zip(theirs) {
                 if m != 0 {
@@ -91,7 +90,7 @@ fn number_fresh(number: &mut [u32], next: usize) -> Vec<u32> {
     let counts = chunks::map(number.chunks(size).collect(), |c| {
         c.iter().filter(|&&n| n == 0).count()
     });
-    let mut fresh = vec![0u32; counts.iter().sum()];
+    let mut fresh = chunks::fill(counts.iter().sum(), 0, |_| 0u32);
     let jobs = number
         .chunks_mut(size)
         .zip(chunks::split(&mut fresh, &counts));

@@ -9,7 +9,6 @@
 //! the box of the four cubes and meets its faces only at vertices, so it cannot cross another
 //! cube's triangles.
 
-use alloc::vec;
 use alloc::vec::Vec;
 
 use core::sync::atomic::Ordering::Relaxed;
@@ -114,7 +113,7 @@ fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> Vec<[u32
         c.iter().filter(|&c| four(c)).count()
     });
     // Per vertex its group plus one, 0 for none.
-    let mut slot = vec![0u32; vertices];
+    let mut slot = chunks::fill(vertices, threads, |_| 0u32);
     let jobs = count.chunks(vsize).zip(slot.chunks_mut(vsize));
     let jobs = jobs.zip(chunks::offsets(&fours)).collect();
     chunks::map(jobs, |((count, slot), before)| {
@@ -229,9 +228,10 @@ fn compact<L: Label>(
     let kept = chunks::map(gone_vertex.chunks(size).collect(), |gone| {
         gone.iter().filter(|g| !g.load(Relaxed)).count()
     });
-    // Zeroed lists are fresh pages, written first by the chunks, on their threads.
-    let mut new_id = vec![0u32; gone_vertex.len()];
-    let mut positions = vec![[0f32; 3]; kept.iter().sum()];
+    // The new lists are cleared on threads too: a large zeroed allocation mostly reuses freed
+    // memory, which the allocator would clear on this thread alone.
+    let mut new_id = chunks::fill(gone_vertex.len(), threads, |_| 0u32);
+    let mut positions = chunks::fill(kept.iter().sum(), threads, |_| [0f32; 3]);
     let jobs = atlas.positions.chunks(size).zip(gone_vertex.chunks(size));
     let jobs = jobs.zip(new_id.chunks_mut(size));
     let jobs = jobs.zip(chunks::split(&mut positions, &kept));
@@ -253,8 +253,8 @@ fn compact<L: Label>(
     let kept = chunks::map(fate.chunks(size).collect(), |fate| {
         fate.iter().filter(|f| f.load(Relaxed) != GONE).count()
     });
-    let mut triangles = vec![[0u32; 3]; kept.iter().sum()];
-    let mut pairs = vec![[L::ZERO; 2]; triangles.len()];
+    let mut triangles = chunks::fill(kept.iter().sum(), threads, |_| [0u32; 3]);
+    let mut pairs = chunks::fill(triangles.len(), threads, |_| [L::ZERO; 2]);
     let jobs = atlas.triangles.chunks(size).zip(atlas.pairs.chunks(size));
     let jobs = jobs.zip(fate.chunks(size));
     let jobs = jobs.zip(chunks::split(&mut triangles, &kept));
