@@ -10,9 +10,13 @@ use alloc::vec::Vec;
 pub(super) fn size(n: usize, threads: usize) -> usize {
     match threads {
         1 => n.max(1),
-        _ => n.div_ceil(64).max(1 << 10),
+        _ => n.div_ceil(64).max(SMALLEST),
     }
 }
+
+/// The fewest items in a chunk; a few in unit tests, so that a small volume runs in many
+/// chunks there.
+const SMALLEST: usize = if cfg!(test) { 3 } else { 1 << 10 };
 
 /// `f` of each job, in order; one job runs on this thread, not handed to the pool.
 #[cfg(feature = "std")]

@@ -20,6 +20,8 @@ mod join;
 mod merge;
 mod smooth;
 mod sweep;
+#[cfg(test)]
+mod tests;
 
 use core::ops::Range;
 
