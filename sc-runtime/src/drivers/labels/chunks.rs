@@ -77,3 +77,25 @@ pub(super) fn split<'a, T>(mut out: &'a mut [T], lengths: &[usize]) -> Vec<&'a m
         })
         .collect()
 }
+
+/// Keeps the first `kept[k]` items of each chunk `k` of `size` items, in order, and drops the
+/// rest. One chunk is cut short in place; several are copied into a new list on threads, as
+/// moving each run down in place would have to wait for the runs before it.
+pub(super) fn gather<T: Copy + Send + Sync>(
+    items: &mut Vec<T>,
+    size: usize,
+    kept: &[usize],
+    threads: usize,
+) {
+    let filler = match (kept, items.first()) {
+        ([n], _) => return items.truncate(*n),
+        (_, None) => return,
+        (_, Some(&first)) => first,
+    };
+    let mut out = fill(kept.iter().sum(), threads, |_| filler);
+    let jobs = split(&mut out, kept).into_iter().zip(items.chunks(size));
+    map(jobs.collect(), |(out, run)| {
+        out.copy_from_slice(&run[..out.len()])
+    });
+    *items = out;
+}

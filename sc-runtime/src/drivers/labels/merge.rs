@@ -23,7 +23,7 @@ pub(super) struct Merged {
     /// Each old vertex's new id, `u32::MAX` if it was merged away.
     pub kept: Vec<u32>,
     /// Each old triangle's fate (see [`KEEP`]).
-    fate: Vec<AtomicU32>,
+    fate: Vec<AtomicU8>,
 }
 
 impl Merged {
@@ -33,12 +33,11 @@ impl Merged {
     }
 }
 
-/// A triangle's fate, [`KEEP`], [`GONE`], or `REPLACED + 2g + r`: replaced by the `r`-th
-/// triangle of group `g`'s merged pair. Groups are fewer than a quarter of the triangles, so
-/// this fits.
-const KEEP: u32 = 0;
-const GONE: u32 = 1;
-const REPLACED: u32 = 2;
+/// A triangle's fate: [`KEEP`], [`GONE`], or `REPLACED + r`, replaced by the `r`-th triangle of
+/// the merged pair of its grey vertex, the ear's middle one.
+const KEEP: u8 = 0;
+const GONE: u8 = 1;
+const REPLACED: u8 = 2;
 
 /// Merges what may merge among `ears`, then drops the vertices and triangles merged away;
 /// returns, if any ear was looked at, what became of each old vertex and triangle.
@@ -52,7 +51,7 @@ pub(super) fn merge<L: Label>(
         return None;
     }
     let threads = params.threads;
-    let groups = around(&ears, atlas.positions.len(), threads);
+    let (groups, slot) = around(&ears, atlas.positions.len(), threads);
     // Each ear is one grey vertex's, so the decisions are independent: made on threads.
     let decide = |g: usize| {
         let [a, b, c, d] = groups[g].map(|e| &ears[e as usize]);
@@ -65,18 +64,17 @@ pub(super) fn merge<L: Label>(
     let decisions: Vec<Option<[[u32; 3]; 2]>> = chunks::fill(groups.len(), threads, decide);
     // Applied on threads too, as marks: each triangle is one ear's at most, each ear one
     // group's, so no two groups mark the same triangle or vertex.
-    let fate = chunks::fill(atlas.triangles.len(), threads, |_| AtomicU32::new(KEEP));
+    let fate = chunks::fill(atlas.triangles.len(), threads, |_| AtomicU8::new(KEEP));
     let gone_vertex = chunks::fill(atlas.positions.len(), threads, |_| AtomicBool::new(false));
     let size = chunks::size(groups.len(), threads);
-    let jobs = groups.chunks(size).zip(decisions.chunks(size));
-    let merged = chunks::map(jobs.enumerate().collect(), |(k, (groups, decisions))| {
+    let jobs = groups.chunks(size).zip(decisions.chunks(size)).collect();
+    let merged = chunks::map(jobs, |(groups, decisions)| {
         let mut merged = 0;
-        for (i, (group, decision)) in groups.iter().zip(decisions).enumerate() {
+        for (group, decision) in groups.iter().zip(decisions) {
             if decision.is_some() {
                 let [a, b, c, d] = group.map(|e| &ears[e as usize]);
-                let replaced = REPLACED + 2 * (k * size + i) as u32;
-                fate[a.triangle as usize].store(replaced, Relaxed);
-                fate[b.triangle as usize].store(replaced + 1, Relaxed);
+                fate[a.triangle as usize].store(REPLACED, Relaxed);
+                fate[b.triangle as usize].store(REPLACED + 1, Relaxed);
                 fate[c.triangle as usize].store(GONE, Relaxed);
                 fate[d.triangle as usize].store(GONE, Relaxed);
                 gone_vertex[a.vertex as usize].store(true, Relaxed);
@@ -89,14 +87,19 @@ pub(super) fn merge<L: Label>(
     .sum::<u64>();
     atlas.stats.merged += merged;
     atlas.stats.blocked += groups.len() as u64 - merged;
-    let kept = compact(atlas, &gone_vertex, &fate, &decisions, threads);
+    // A replaced triangle is an ear, its middle vertex the grey one: that names its group.
+    let merged_pair = |t: &[u32; 3], r: u8| {
+        let pair = decisions[slot[t[1] as usize] as usize - 1].as_ref();
+        pair.map_or(*t, |pair| pair[usize::from(r)])
+    };
+    let kept = compact(atlas, &gone_vertex, &fate, merged_pair, threads);
     Some(Merged { kept, fate })
 }
 
 /// The ears of each grey vertex with four, by ascending vertex, each group in the order the ears
 /// came: a counting sort, the ears being many and their vertices dense, in chunks on threads
-/// unless one was asked for.
-fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> Vec<[u32; 4]> {
+/// unless one was asked for; with, per vertex, its group plus one (0 for none).
+fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> (Vec<[u32; 4]>, Vec<u32>) {
     // At most four ears a vertex, one per cube around its grid edge: a byte counts them.
     let count = chunks::fill(vertices, threads, |_| AtomicU8::new(0));
     let size = chunks::size(ears.len(), threads);
@@ -138,11 +141,12 @@ fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> Vec<[u32
             }
         }
     });
-    chunks::fill(groups, threads, |g| {
+    let groups = chunks::fill(groups, threads, |g| {
         let mut group: [u32; 4] = core::array::from_fn(|i| out[4 * g + i].load(Relaxed));
         group.sort_unstable();
         group
-    })
+    });
+    (groups, slot)
 }
 
 /// The two triangles replacing the four ears `[back, grey, forward]` around a grey vertex, split
@@ -211,16 +215,15 @@ fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> b
     }
 }
 
-/// Drops the vertices marked gone and the triangles whose fate is [`GONE`], puts the
-/// merged pairs in place of the triangles they replace, and renumbers the vertices in their
-/// order; returns the new ids. Runs in chunks, on threads unless one was asked for: each chunk
-/// counts what it keeps, then copies it to its place in new lists, after what those before it
-/// kept.
+/// Drops the vertices marked gone and the triangles whose fate is [`GONE`], puts `merged_pair`
+/// of each triangle replaced (and its fate's `r`) in its place, and renumbers the vertices in
+/// their order; returns the new ids. Runs in chunks, on threads unless one was asked for: each
+/// chunk keeps its own items at its start, then the chunks' kept runs are gathered.
 fn compact<L: Label>(
     atlas: &mut Atlas<L>,
     gone_vertex: &[AtomicBool],
-    fate: &[AtomicU32],
-    decisions: &[Option<[[u32; 3]; 2]>],
+    fate: &[AtomicU8],
+    merged_pair: impl Fn(&[u32; 3], u8) -> [u32; 3] + Sync,
     threads: usize,
 ) -> Vec<u32> {
     // Vertices: each chunk's first new id is the number kept before it.
@@ -228,54 +231,47 @@ fn compact<L: Label>(
     let kept = chunks::map(gone_vertex.chunks(size).collect(), |gone| {
         gone.iter().filter(|g| !g.load(Relaxed)).count()
     });
-    // The new lists are cleared on threads too: a large zeroed allocation mostly reuses freed
-    // memory, which the allocator would clear on this thread alone.
-    let mut new_id = chunks::fill(gone_vertex.len(), threads, |_| 0u32);
-    let mut positions = chunks::fill(kept.iter().sum(), threads, |_| [0f32; 3]);
-    let jobs = atlas.positions.chunks(size).zip(gone_vertex.chunks(size));
+    let mut new_id = chunks::fill(gone_vertex.len(), threads, |_| u32::MAX);
+    let jobs = atlas
+        .positions
+        .chunks_mut(size)
+        .zip(gone_vertex.chunks(size));
     let jobs = jobs.zip(new_id.chunks_mut(size));
-    let jobs = jobs.zip(chunks::split(&mut positions, &kept));
     let jobs = jobs.zip(chunks::offsets(&kept)).collect();
-    chunks::map(jobs, |((((p, gone), ids), out), first)| {
+    chunks::map(jobs, |(((p, gone), ids), first)| {
         let mut n = 0;
-        for ((p, gone), id) in p.iter().zip(gone).zip(ids) {
-            if gone.load(Relaxed) {
-                *id = u32::MAX;
-            } else {
-                *id = (first + n) as u32;
-                out[n] = *p;
+        for v in 0..p.len() {
+            if !gone[v].load(Relaxed) {
+                ids[v] = (first + n) as u32;
+                p[n] = p[v];
                 n += 1;
             }
         }
     });
-    atlas.positions = positions;
+    chunks::gather(&mut atlas.positions, size, &kept, threads);
     let size = chunks::size(fate.len(), threads);
     let kept = chunks::map(fate.chunks(size).collect(), |fate| {
         fate.iter().filter(|f| f.load(Relaxed) != GONE).count()
     });
-    let mut triangles = chunks::fill(kept.iter().sum(), threads, |_| [0u32; 3]);
-    let mut pairs = chunks::fill(triangles.len(), threads, |_| [L::ZERO; 2]);
-    let jobs = atlas.triangles.chunks(size).zip(atlas.pairs.chunks(size));
-    let jobs = jobs.zip(fate.chunks(size));
-    let jobs = jobs.zip(chunks::split(&mut triangles, &kept));
-    let jobs = jobs.zip(chunks::split(&mut pairs, &kept)).collect();
-    chunks::map(jobs, |((((t, p), fate), out_t), out_p)| {
+    let jobs = atlas
+        .triangles
+        .chunks_mut(size)
+        .zip(atlas.pairs.chunks_mut(size));
+    let jobs = jobs.zip(fate.chunks(size)).collect();
+    chunks::map(jobs, |((t, p), fate)| {
         let mut n = 0;
-        for ((t, p), fate) in t.iter().zip(p).zip(fate) {
-            let t = match fate.load(Relaxed) {
+        for i in 0..t.len() {
+            let kept = match fate[i].load(Relaxed) {
                 GONE => continue,
-                KEEP => t,
-                f => {
-                    let (g, r) = ((f - REPLACED) as usize / 2, (f - REPLACED) as usize % 2);
-                    decisions[g].as_ref().map_or(t, |pair| &pair[r])
-                }
+                KEEP => t[i],
+                f => merged_pair(&t[i], f - REPLACED),
             };
-            out_t[n] = t.map(|v| new_id[v as usize]);
-            out_p[n] = *p;
+            t[n] = kept.map(|v| new_id[v as usize]);
+            p[n] = p[i];
             n += 1;
         }
     });
-    atlas.triangles = triangles;
-    atlas.pairs = pairs;
+    chunks::gather(&mut atlas.triangles, size, &kept, threads);
+    chunks::gather(&mut atlas.pairs, size, &kept, threads);
     new_id
 }
