@@ -78,24 +78,44 @@ pub(super) fn split<'a, T>(mut out: &'a mut [T], lengths: &[usize]) -> Vec<&'a m
         .collect()
 }
 
-/// Keeps the first `kept[k]` items of each chunk `k` of `size` items, in order, and drops the
-/// rest. One chunk is cut short in place; several are copied into a new list on threads, as
-/// moving each run down in place would have to wait for the runs before it.
-pub(super) fn gather<T: Copy + Send + Sync>(
+/// Keeps, in order and in place, `value(i, item)` of each item `i` that `keep(i)`, and drops
+/// the rest: in place, as new lists would cost a page fault per page. On the pool, in one part
+/// per worker: each part moves its kept items down within itself, but those whose place lies in
+/// a part before it wait aside until every part is done (moving a part down in place waits for
+/// the parts before it to move).
+pub(super) fn sieve<T: Copy + Send + Sync>(
     items: &mut Vec<T>,
-    size: usize,
-    kept: &[usize],
     threads: usize,
+    keep: impl Fn(usize) -> bool + Sync,
+    value: impl Fn(usize, &T) -> T + Sync,
 ) {
-    let filler = match (kept, items.first()) {
-        ([n], _) => return items.truncate(*n),
-        (_, None) => return,
-        (_, Some(&first)) => first,
-    };
-    let mut out = fill(kept.iter().sum(), threads, |_| filler);
-    let jobs = split(&mut out, kept).into_iter().zip(items.chunks(size));
-    map(jobs.collect(), |(out, run)| {
-        out.copy_from_slice(&run[..out.len()])
+    let n = items.len();
+    let size = n.div_ceil(super::workers(threads)).max(SMALLEST);
+    let starts: Vec<usize> = (0..n).step_by(size).collect();
+    let kept = map(starts, |start| {
+        (start..n.min(start + size)).filter(|&i| keep(i)).count()
     });
-    *items = out;
+    let before = offsets(&kept);
+    let jobs = items.chunks_mut(size).zip(before.iter().copied());
+    let aside = map(jobs.enumerate().collect(), |(k, (part, first))| {
+        let start = k * size;
+        let mut aside = Vec::new();
+        let mut to = first;
+        for i in 0..part.len() {
+            if keep(start + i) {
+                let item = value(start + i, &part[i]);
+                if to < start {
+                    aside.push(item);
+                } else {
+                    part[to - start] = item;
+                }
+                to += 1;
+            }
+        }
+        aside
+    });
+    for (aside, first) in aside.iter().zip(before) {
+        items[first..first + aside.len()].copy_from_slice(aside);
+    }
+    items.truncate(kept.iter().sum());
 }
