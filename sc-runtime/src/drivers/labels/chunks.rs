@@ -78,44 +78,38 @@ pub(super) fn split<'a, T>(mut out: &'a mut [T], lengths: &[usize]) -> Vec<&'a m
         .collect()
 }
 
-/// Keeps, in order and in place, `value(i, item)` of each item `i` that `keep(i)`, and drops
-/// the rest: in place, as new lists would cost a page fault per page. On the pool, in one part
-/// per worker: each part moves its kept items down within itself, but those whose place lies in
-/// a part before it wait aside until every part is done (moving a part down in place waits for
-/// the parts before it to move).
-pub(super) fn sieve<T: Copy + Send + Sync>(
+/// Keeps the first `kept[k]` items of each chunk `k` of `size` items, in order, and drops the
+/// rest, in place: new lists would cost a page fault per page. On the pool, in one part of
+/// consecutive chunks per worker: each part moves its runs down within itself, but what belongs
+/// in a part before it waits aside until every part is done (moving a part down in place would
+/// wait for the parts before it to move).
+pub(super) fn gather<T: Copy + Send + Sync>(
     items: &mut Vec<T>,
+    size: usize,
+    kept: &[usize],
     threads: usize,
-    keep: impl Fn(usize) -> bool + Sync,
-    value: impl Fn(usize, &T) -> T + Sync,
 ) {
-    let n = items.len();
-    let size = n.div_ceil(super::workers(threads)).max(SMALLEST);
-    let starts: Vec<usize> = (0..n).step_by(size).collect();
-    let kept = map(starts, |start| {
-        (start..n.min(start + size)).filter(|&i| keep(i)).count()
-    });
-    let before = offsets(&kept);
-    let jobs = items.chunks_mut(size).zip(before.iter().copied());
-    let aside = map(jobs.enumerate().collect(), |(k, (part, first))| {
-        let start = k * size;
+    let before = offsets(kept);
+    let per_part = kept.len().div_ceil(super::workers(threads)).max(1);
+    let jobs = items.chunks_mut(per_part * size).enumerate();
+    let jobs = jobs.map(|(p, part)| (p * per_part * size, part, p * per_part));
+    let aside = map(jobs.collect(), |(start, part, first_chunk)| {
         let mut aside = Vec::new();
-        let mut to = first;
-        for i in 0..part.len() {
-            if keep(start + i) {
-                let item = value(start + i, &part[i]);
-                if to < start {
-                    aside.push(item);
-                } else {
-                    part[to - start] = item;
-                }
-                to += 1;
+        let runs = kept.iter().zip(&before).enumerate().skip(first_chunk);
+        for (k, (&n, &to)) in runs.take(per_part) {
+            let from = k * size - start;
+            // The run's first items belong before this part.
+            let early = start.saturating_sub(to).min(n);
+            aside.extend_from_slice(&part[from..from + early]);
+            if early < n {
+                part.copy_within(from + early..from + n, to + early - start);
             }
         }
         aside
     });
-    for (aside, first) in aside.iter().zip(before) {
-        items[first..first + aside.len()].copy_from_slice(aside);
+    for (aside, p) in aside.iter().zip((0..kept.len()).step_by(per_part)) {
+        let to = before[p];
+        items[to..to + aside.len()].copy_from_slice(aside);
     }
     items.truncate(kept.iter().sum());
 }

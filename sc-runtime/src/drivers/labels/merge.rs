@@ -217,7 +217,8 @@ fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> b
 
 /// Drops the vertices marked gone and the triangles whose fate is [`GONE`], puts `merged_pair`
 /// of each triangle replaced (and its fate's `r`) in its place, and renumbers the vertices in
-/// their order; returns the new ids. On threads unless one was asked for.
+/// their order; returns the new ids. Runs in chunks, on threads unless one was asked for: each
+/// chunk keeps its own items at its start, then the chunks' kept runs are gathered.
 fn compact<L: Label>(
     atlas: &mut Atlas<L>,
     gone_vertex: &[AtomicBool],
@@ -225,41 +226,52 @@ fn compact<L: Label>(
     merged_pair: impl Fn(&[u32; 3], u8) -> [u32; 3] + Sync,
     threads: usize,
 ) -> Vec<u32> {
-    // In chunks, each numbering its kept vertices after those kept before it.
+    // Vertices: each chunk's first new id is the number kept before it.
     let size = chunks::size(gone_vertex.len(), threads);
     let kept = chunks::map(gone_vertex.chunks(size).collect(), |gone| {
         gone.iter().filter(|g| !g.load(Relaxed)).count()
     });
-    let mut new_id = chunks::fill(gone_vertex.len(), threads, |_| 0u32);
-    let jobs = gone_vertex.chunks(size).zip(new_id.chunks_mut(size));
-    chunks::map(
-        jobs.zip(chunks::offsets(&kept)).collect(),
-        |((gone, ids), first)| {
-            let mut next = first as u32;
-            for (gone, id) in gone.iter().zip(ids) {
-                *id = if gone.load(Relaxed) {
-                    u32::MAX
-                } else {
-                    next += 1;
-                    next - 1
-                };
+    let mut new_id = chunks::fill(gone_vertex.len(), threads, |_| u32::MAX);
+    let jobs = atlas
+        .positions
+        .chunks_mut(size)
+        .zip(gone_vertex.chunks(size));
+    let jobs = jobs.zip(new_id.chunks_mut(size));
+    let jobs = jobs.zip(chunks::offsets(&kept)).collect();
+    chunks::map(jobs, |(((p, gone), ids), first)| {
+        let mut n = 0;
+        for v in 0..p.len() {
+            if !gone[v].load(Relaxed) {
+                ids[v] = (first + n) as u32;
+                p[n] = p[v];
+                n += 1;
             }
-        },
-    );
-    chunks::sieve(
-        &mut atlas.positions,
-        threads,
-        |v| !gone_vertex[v].load(Relaxed),
-        |_, p| *p,
-    );
-    let stays = |t: usize| fate[t].load(Relaxed) != GONE;
-    chunks::sieve(&mut atlas.triangles, threads, stays, |t, old| {
-        let new = match fate[t].load(Relaxed) {
-            KEEP => *old,
-            f => merged_pair(old, f - REPLACED),
-        };
-        new.map(|v| new_id[v as usize])
+        }
     });
-    chunks::sieve(&mut atlas.pairs, threads, stays, |_, p| *p);
+    chunks::gather(&mut atlas.positions, size, &kept, threads);
+    let size = chunks::size(fate.len(), threads);
+    let kept = chunks::map(fate.chunks(size).collect(), |fate| {
+        fate.iter().filter(|f| f.load(Relaxed) != GONE).count()
+    });
+    let jobs = atlas
+        .triangles
+        .chunks_mut(size)
+        .zip(atlas.pairs.chunks_mut(size));
+    let jobs = jobs.zip(fate.chunks(size)).collect();
+    chunks::map(jobs, |((t, p), fate)| {
+        let mut n = 0;
+        for i in 0..t.len() {
+            let kept = match fate[i].load(Relaxed) {
+                GONE => continue,
+                KEEP => t[i],
+                f => merged_pair(&t[i], f - REPLACED),
+            };
+            t[n] = kept.map(|v| new_id[v as usize]);
+            p[n] = p[i];
+            n += 1;
+        }
+    });
+    chunks::gather(&mut atlas.triangles, size, &kept, threads);
+    chunks::gather(&mut atlas.pairs, size, &kept, threads);
     new_id
 }
