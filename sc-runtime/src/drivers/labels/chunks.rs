@@ -89,6 +89,9 @@ pub(super) fn gather<T: Copy + Send + Sync>(
     kept: &[usize],
     threads: usize,
 ) {
+    if let [n] = kept {
+        return items.truncate(*n);
+    }
     let before = offsets(kept);
     let per_part = kept.len().div_ceil(super::workers(threads)).max(1);
     let jobs = items.chunks_mut(per_part * size).enumerate();
@@ -101,7 +104,7 @@ pub(super) fn gather<T: Copy + Send + Sync>(
             // The run's first items belong before this part.
             let early = start.saturating_sub(to).min(n);
             aside.extend_from_slice(&part[from..from + early]);
-            if early < n {
+            if early < n && k * size != to {
                 part.copy_within(from + early..from + n, to + early - start);
             }
         }
