@@ -313,7 +313,8 @@ impl<L> Default for Atlas<L> {
 
 impl<L: Label> Atlas<L> {
     /// The labels with a surface, ascending, without the background (`background`). Found on
-    /// `threads` threads as [`Atlas::meshes`] is cut; the labels do not depend on it.
+    /// `threads` threads (0 for all, 1 for the calling thread alone; the labels do not depend on
+    /// it); where a pool cannot be started, on this thread.
     pub fn labels(&self, background: L, threads: usize) -> Vec<L> {
         let n = self.pairs.len();
         #[cfg(not(feature = "std"))]
