@@ -129,14 +129,14 @@ fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> (Vec<[u3
         }
     });
     let groups = fours.iter().sum::<usize>();
-    // Each ear takes a place in its group as the count comes down; the places are then put
-    // back in the order the ears came.
+    // Each ear takes the next place in its group as the count comes down, so on one thread the
+    // ears are in the order they came already; on several, they are sorted back into it.
     let out = chunks::fill(4 * groups, threads, |_| AtomicU32::new(0));
     chunks::map(ears.chunks(size).enumerate().collect(), |(k, ears)| {
         for (i, ear) in ears.iter().enumerate() {
             let v = ear.vertex as usize;
             if slot[v] != 0 {
-                let place = usize::from(count[v].fetch_sub(1, Relaxed)) - 1;
+                let place = 4 - usize::from(count[v].fetch_sub(1, Relaxed));
                 out[4 * (slot[v] as usize - 1) + place].store((k * size + i) as u32, Relaxed);
             }
         }
