@@ -105,7 +105,7 @@ fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> (Vec<[u3
     let size = chunks::size(ears.len(), threads);
     chunks::map(ears.chunks(size).collect(), |ears| {
         for ear in ears {
-            count[ear.vertex as usize].fetch_add(1, Relaxed);
+            add(&count[ear.vertex as usize], 1, threads);
         }
     });
     // Fewer than four ears: a cube around the edge is not binary, or lies outside the grid.
@@ -136,7 +136,7 @@ fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> (Vec<[u3
         for (i, ear) in ears.iter().enumerate() {
             let v = ear.vertex as usize;
             if slot[v] != 0 {
-                let place = 4 - usize::from(count[v].fetch_sub(1, Relaxed));
+                let place = 4 - usize::from(add(&count[v], u8::MAX, threads));
                 out[4 * (slot[v] as usize - 1) + place].store((k * size + i) as u32, Relaxed);
             }
         }
@@ -147,6 +147,19 @@ fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> (Vec<[u3
         group
     });
     (groups, slot)
+}
+
+/// Adds `n` to `count` (wrapping), returning the count before: as one atomic step on threads,
+/// as a plain load and store on one, where the work runs as one chunk on this thread alone and
+/// an atomic read-modify-write would cost tens of cycles for nothing.
+fn add(count: &AtomicU8, n: u8, threads: usize) -> u8 {
+    if threads == 1 {
+        let c = count.load(Relaxed);
+        count.store(c.wrapping_add(n), Relaxed);
+        c
+    } else {
+        count.fetch_add(n, Relaxed)
+    }
 }
 
 /// The two triangles replacing the four ears `[back, grey, forward]` around a grey vertex, split
