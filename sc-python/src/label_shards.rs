@@ -150,7 +150,7 @@ where
     let selection = match &s.selection {
         Selection::All => None,
         Selection::Only(ranges) => {
-            let present = atlas.labels(background);
+            let present = atlas.labels(background, 0);
             let mut wanted = Vec::new();
             for range in ranges {
                 let inside = within(range, &present);

@@ -171,7 +171,11 @@ where
     if !world.is_translation() {
         py.detach(|| place(world, &mut atlas));
     }
-    let chosen = choose(&atlas.labels(background), background, reply.selection)?;
+    let chosen = choose(
+        &atlas.labels(background, reply.threads),
+        background,
+        reply.selection,
+    )?;
     let meshes = py.detach(|| atlas.meshes(&chosen, normals, reply.threads));
 
     let stats = PyDict::new(py);

@@ -59,7 +59,7 @@ fn time<L: Label + Into<u64> + TryFrom<u64>>(
         let t0 = Instant::now();
         let atlas = extract_labels(volume, &params)?;
         let t1 = Instant::now();
-        let labels = atlas.labels(params.background);
+        let labels = atlas.labels(params.background, params.threads);
         let meshes = atlas.meshes(&labels, false, params.threads);
         let t2 = Instant::now();
         sweep = sweep.min(t1 - t0);

@@ -418,7 +418,8 @@ fn check_volume(vol: &Labels, mode: Mode, what: &str) {
         crossings.len(),
         &crossings[..crossings.len().min(4)]
     );
-    let labels = atlas.labels(0);
+    let labels = atlas.labels(0, 1);
+    assert_eq!(atlas.labels(0, 3), labels, "{what}: threads");
     let meshes = atlas.meshes(&labels, false, 1);
     assert_eq!(
         atlas.meshes(&labels, true, 3),
@@ -630,7 +631,7 @@ fn another_background_is_a_relabelling() {
 fn large_and_negative_labels_are_a_relabelling() {
     let vol = cells([13, 11, 12], 9, 3);
     let small = vol.atlas(Mode::Embedded);
-    let labels = small.labels(0);
+    let labels = small.labels(0, 1);
     let meshes = small.meshes(&labels, true, 1);
     fn same<L: sc_runtime::labels::Label>(
         data: &[L],
@@ -650,7 +651,7 @@ fn large_and_negative_labels_are_a_relabelling() {
         assert_eq!(atlas.triangles, small.triangles);
         let pairs: Vec<[L; 2]> = small.pairs.iter().map(|p| p.map(&relabel)).collect();
         assert_eq!(atlas.pairs, pairs);
-        let labels = atlas.labels(relabel(0));
+        let labels = atlas.labels(relabel(0), 1);
         let expected: Vec<L> = meshes.iter().map(|&(l, _)| relabel(l)).collect();
         assert_eq!(labels, expected);
         for threads in [1, 3] {
@@ -757,7 +758,7 @@ fn check_smoothed(vol: &Labels, what: &str) {
         "{what}: {} crossings",
         crossings.len()
     );
-    let labels = atlas.labels(0);
+    let labels = atlas.labels(0, 1);
     for (label, mesh) in atlas.meshes(&labels, false, 0) {
         let problems = manifold_problems(mesh.positions.len(), &mesh.triangles, 5);
         assert!(problems.is_empty(), "{what} label {label}: {problems:?}");

@@ -214,7 +214,7 @@ pub(super) fn select<L>(
 where
     L: Sample + TryInto<i64>,
 {
-    let chosen = chosen(&atlas.labels(background), request)?;
+    let chosen = chosen(&atlas.labels(background, request.threads), request)?;
     let meshes = atlas
         .meshes(&chosen, request.normals, request.threads)
         .into_iter()

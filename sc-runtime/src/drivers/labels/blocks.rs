@@ -239,7 +239,7 @@ fn share<L: Label>(
         *count += 1;
     }
     let merged = merge::merge(window, params, ears, &mut atlas);
-    let new_id = |v: usize| merged.as_ref().map_or(v as u32, |(kept, _)| kept[v]);
+    let new_id = |v: usize| merged.as_ref().map_or(v as u32, |m| m.kept[v]);
     for (v, &(count, counts)) in around.iter().enumerate() {
         if count == 4 && counts {
             if new_id(v) == u32::MAX {
@@ -253,7 +253,7 @@ fn share<L: Label>(
     let mut used = vec![u32::MAX; atlas.positions.len()];
     let mut now = 0;
     for t in 0..nt {
-        if merged.as_ref().is_some_and(|(_, gone)| gone[t]) {
+        if merged.as_ref().is_some_and(|m| m.gone(t)) {
             continue;
         }
         if owned(t) {

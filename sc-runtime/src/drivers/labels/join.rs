@@ -1,11 +1,10 @@
 //! Joining the pieces of a label sweep: the vertices of the plane two pieces share were made
 //! by both, and are kept once, with the lower piece's number.
 
-use alloc::vec;
 use alloc::vec::Vec;
 
 use super::sweep::{Ear, Edge, Piece};
-use super::{Atlas, Label};
+use super::{Atlas, Label, chunks};
 
 /// The pieces, in order of their layers, as one atlas, with their ears, vertex edges and
 /// pinned vertices renumbered alike.
@@ -36,7 +35,8 @@ pub(super) fn join<L: Label>(
     // The previous piece's top plane, in the joined numbering (plus one, 0 for none).
     let mut shared = top;
     for piece in rest {
-        let mut number = vec![u32::MAX; piece.atlas.positions.len()];
+        // Per vertex of the piece, its joined id plus one where the lower piece made it, else 0.
+        let mut number = chunks::fill(piece.atlas.positions.len(), 0, |_| 0u32);
         for (mine, theirs) in piece.bottom.iter().zip(&shared) {
             for (&m, &t) in mine.iter().zip(theirs) {
                 if m != 0 {
@@ -44,18 +44,16 @@ pub(super) fn join<L: Label>(
                         t != 0,
                         "a vertex of the shared plane made by one piece only"
                     );
-                    number[m as usize - 1] = t - 1;
+                    number[m as usize - 1] = t;
                 }
             }
         }
-        for (v, (n, p)) in number.iter_mut().zip(&piece.atlas.positions).enumerate() {
-            if *n == u32::MAX {
-                *n = atlas.positions.len() as u32;
-                atlas.positions.push(*p);
-                if let Some(&edge) = piece.edges.get(v) {
-                    edges.push(edge);
-                }
-            }
+        let fresh = number_fresh(&mut number, atlas.positions.len());
+        extend_mapped(&mut atlas.positions, &fresh, |&v| {
+            piece.atlas.positions[v as usize]
+        });
+        if !piece.edges.is_empty() {
+            extend_mapped(&mut edges, &fresh, |&v| piece.edges[v as usize]);
         }
         pinned.extend(piece.pinned.iter().map(|&v| number[v as usize]));
         let first_triangle = atlas.triangles.len() as u32;
@@ -82,6 +80,34 @@ pub(super) fn join<L: Label>(
         });
     }
     (atlas, ears, edges, pinned)
+}
+
+/// Numbers the vertices `number` marks 0 (the piece's own) from `next` in their order, and
+/// the others by their mark less one; returns the piece's own vertices, in order. In chunks on
+/// the current pool: each chunk counts its own vertices, then numbers them after those before.
+fn number_fresh(number: &mut [u32], next: usize) -> Vec<u32> {
+    let size = chunks::size(number.len(), 0);
+    let counts = chunks::map(number.chunks(size).collect(), |c| {
+        c.iter().filter(|&&n| n == 0).count()
+    });
+    let mut fresh = chunks::fill(counts.iter().sum(), 0, |_| 0u32);
+    let jobs = number
+        .chunks_mut(size)
+        .zip(chunks::split(&mut fresh, &counts));
+    let jobs = jobs.zip(chunks::offsets(&counts)).enumerate().collect();
+    chunks::map(jobs, |(k, ((number, fresh), before))| {
+        let mut n = 0;
+        for (i, v) in number.iter_mut().enumerate() {
+            if *v == 0 {
+                *v = (next + before + n) as u32;
+                fresh[n] = (k * size + i) as u32;
+                n += 1;
+            } else {
+                *v -= 1;
+            }
+        }
+    });
+    fresh
 }
 
 /// `to` extended by `f` of each of `from`, on the current pool: the copies are most of a join.

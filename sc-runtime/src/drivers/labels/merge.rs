@@ -9,105 +9,157 @@
 //! the box of the four cubes and meets its faces only at vertices, so it cannot cross another
 //! cube's triangles.
 
-use alloc::vec;
 use alloc::vec::Vec;
 
+use core::sync::atomic::Ordering::Relaxed;
+use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32};
+
 use super::sweep::{Ear, Padded};
-use super::{Atlas, Label, LabelParams};
+use super::{Atlas, Label, LabelParams, chunks};
 use crate::Mode;
 
+/// The outcome of Step 4 on an atlas.
+pub(super) struct Merged {
+    /// Each old vertex's new id, `u32::MAX` if it was merged away.
+    pub kept: Vec<u32>,
+    /// Each old triangle's fate (see [`KEEP`]).
+    fate: Vec<AtomicU8>,
+}
+
+impl Merged {
+    /// Whether old triangle `t` was merged away.
+    pub fn gone(&self, t: usize) -> bool {
+        self.fate[t].load(Relaxed) == GONE
+    }
+}
+
+/// A triangle's fate: [`KEEP`], [`GONE`], or `REPLACED + r`, replaced by the `r`-th triangle of
+/// the merged pair of its grey vertex, the ear's middle one.
+const KEEP: u8 = 0;
+const GONE: u8 = 1;
+const REPLACED: u8 = 2;
+
 /// Merges what may merge among `ears`, then drops the vertices and triangles merged away;
-/// returns, if any ear was looked at, each old vertex's new id (`u32::MAX` if dropped) and
-/// which old triangles were dropped.
+/// returns, if any ear was looked at, what became of each old vertex and triangle.
 pub(super) fn merge<L: Label>(
     grid: &Padded<'_, L>,
     params: &LabelParams<L>,
     ears: Vec<Ear<L>>,
     atlas: &mut Atlas<L>,
-) -> Option<(Vec<u32>, Vec<bool>)> {
+) -> Option<Merged> {
     if ears.is_empty() {
         return None;
     }
-    let mut gone_vertex = vec![false; atlas.positions.len()];
-    let mut gone_triangle = vec![false; atlas.triangles.len()];
-    let groups = around(&ears, atlas.positions.len());
-    // Each ear is one grey vertex's, so the decisions are independent: made on threads, applied
-    // in order.
-    let decide = |group: &[u32; 4]| {
-        let [a, b, c, d] = group.map(|e| &ears[e as usize]);
+    let threads = params.threads;
+    let (groups, slot) = around(&ears, atlas.positions.len(), threads);
+    // Each ear is one grey vertex's, so the decisions are independent: made on threads.
+    let decide = |g: usize| {
+        let [a, b, c, d] = groups[g].map(|e| &ears[e as usize]);
         let w = a.background;
         let allowed = [b, c, d].iter().all(|e| e.background == w)
             && (params.mode == Mode::Paper
                 || [a, b, c, d].iter().all(|e| e.mergeable) && !blocks(grid, a.lower, a.axis, w));
         allowed.then(|| quad(atlas, [a, b, c, d])).flatten()
     };
-    let decisions: Vec<Option<[[u32; 3]; 2]>> = decide_all(&groups, decide, params.threads);
-    for (group, decision) in groups.iter().zip(decisions) {
-        let [a, b, c, d] = group.map(|e| &ears[e as usize]);
-        let Some([first, second]) = decision else {
-            atlas.stats.blocked += 1;
-            continue;
-        };
-        atlas.triangles[a.triangle as usize] = first;
-        atlas.triangles[b.triangle as usize] = second;
-        gone_triangle[c.triangle as usize] = true;
-        gone_triangle[d.triangle as usize] = true;
-        gone_vertex[a.vertex as usize] = true;
-        atlas.stats.merged += 1;
-    }
-    let kept = compact(atlas, &gone_vertex, &gone_triangle, params.threads);
-    Some((kept, gone_triangle))
-}
-
-/// `decide` for every group, on threads unless one was asked for.
-#[cfg(feature = "std")]
-fn decide_all<T: Send>(
-    groups: &[[u32; 4]],
-    decide: impl Fn(&[u32; 4]) -> T + Sync,
-    threads: usize,
-) -> Vec<T> {
-    use rayon::prelude::*;
-    if threads == 1 {
-        groups.iter().map(decide).collect()
-    } else {
-        groups.par_iter().map(&decide).collect()
-    }
-}
-
-/// `decide` for every group.
-#[cfg(not(feature = "std"))]
-fn decide_all<T>(groups: &[[u32; 4]], decide: impl Fn(&[u32; 4]) -> T, _threads: usize) -> Vec<T> {
-    groups.iter().map(decide).collect()
+    let decisions: Vec<Option<[[u32; 3]; 2]>> = chunks::fill(groups.len(), threads, decide);
+    // Applied on threads too, as marks: each triangle is one ear's at most, each ear one
+    // group's, so no two groups mark the same triangle or vertex.
+    let fate = chunks::fill(atlas.triangles.len(), threads, |_| AtomicU8::new(KEEP));
+    let gone_vertex = chunks::fill(atlas.positions.len(), threads, |_| AtomicBool::new(false));
+    let size = chunks::size(groups.len(), threads);
+    let jobs = groups.chunks(size).zip(decisions.chunks(size)).collect();
+    let merged = chunks::map(jobs, |(groups, decisions)| {
+        let mut merged = 0;
+        for (group, decision) in groups.iter().zip(decisions) {
+            if decision.is_some() {
+                let [a, b, c, d] = group.map(|e| &ears[e as usize]);
+                fate[a.triangle as usize].store(REPLACED, Relaxed);
+                fate[b.triangle as usize].store(REPLACED + 1, Relaxed);
+                fate[c.triangle as usize].store(GONE, Relaxed);
+                fate[d.triangle as usize].store(GONE, Relaxed);
+                gone_vertex[a.vertex as usize].store(true, Relaxed);
+                merged += 1;
+            }
+        }
+        merged
+    })
+    .into_iter()
+    .sum::<u64>();
+    atlas.stats.merged += merged;
+    atlas.stats.blocked += groups.len() as u64 - merged;
+    // A replaced triangle is an ear, its middle vertex the grey one: that names its group.
+    let merged_pair = |t: &[u32; 3], r: u8| {
+        let pair = decisions[slot[t[1] as usize] as usize - 1].as_ref();
+        pair.map_or(*t, |pair| pair[usize::from(r)])
+    };
+    let kept = compact(atlas, &gone_vertex, &fate, merged_pair, threads);
+    Some(Merged { kept, fate })
 }
 
 /// The ears of each grey vertex with four, by ascending vertex, each group in the order the ears
-/// came: a counting sort, the ears being many and their vertices dense.
-fn around<L>(ears: &[Ear<L>], vertices: usize) -> Vec<[u32; 4]> {
-    let mut count = vec![0u8; vertices];
-    for ear in ears {
-        let c = &mut count[ear.vertex as usize];
-        *c = c.saturating_add(1);
-    }
+/// came: a counting sort, the ears being many and their vertices dense, in chunks on threads
+/// unless one was asked for; with, per vertex, its group plus one (0 for none).
+fn around<L: Sync>(ears: &[Ear<L>], vertices: usize, threads: usize) -> (Vec<[u32; 4]>, Vec<u32>) {
+    // At most four ears a vertex, one per cube around its grid edge: a byte counts them.
+    let count = chunks::fill(vertices, threads, |_| AtomicU8::new(0));
+    let size = chunks::size(ears.len(), threads);
+    chunks::map(ears.chunks(size).collect(), |ears| {
+        for ear in ears {
+            add(&count[ear.vertex as usize], 1, threads);
+        }
+    });
     // Fewer than four ears: a cube around the edge is not binary, or lies outside the grid.
-    let mut slot = vec![u32::MAX; vertices];
-    let mut groups = 0u32;
-    for (s, &c) in slot.iter_mut().zip(&count) {
-        if c == 4 {
-            *s = groups;
-            groups += 1;
+    // Each chunk of vertices numbers its groups after those of the chunks before.
+    let four = |c: &AtomicU8| c.load(Relaxed) == 4;
+    let vsize = chunks::size(vertices, threads);
+    let fours = chunks::map(count.chunks(vsize).collect(), |c| {
+        c.iter().filter(|&c| four(c)).count()
+    });
+    // Per vertex its group plus one, 0 for none.
+    let mut slot = chunks::fill(vertices, threads, |_| 0u32);
+    let jobs = count.chunks(vsize).zip(slot.chunks_mut(vsize));
+    let jobs = jobs.zip(chunks::offsets(&fours)).collect();
+    chunks::map(jobs, |((count, slot), before)| {
+        let mut g = before as u32;
+        for (c, s) in count.iter().zip(slot) {
+            if four(c) {
+                g += 1;
+                *s = g;
+            }
         }
-    }
-    let mut out = vec![[0u32; 4]; groups as usize];
-    let mut filled = vec![0u8; groups as usize];
-    for (n, ear) in ears.iter().enumerate() {
-        let g = slot[ear.vertex as usize];
-        if g != u32::MAX {
-            let f = &mut filled[g as usize];
-            out[g as usize][usize::from(*f)] = n as u32;
-            *f += 1;
+    });
+    let groups = fours.iter().sum::<usize>();
+    // Each ear takes the next place in its group as the count comes down, so on one thread the
+    // ears are in the order they came already; on several, they are sorted back into it.
+    let out = chunks::fill(4 * groups, threads, |_| AtomicU32::new(0));
+    chunks::map(ears.chunks(size).enumerate().collect(), |(k, ears)| {
+        for (i, ear) in ears.iter().enumerate() {
+            let v = ear.vertex as usize;
+            if slot[v] != 0 {
+                let place = 4 - usize::from(add(&count[v], u8::MAX, threads));
+                out[4 * (slot[v] as usize - 1) + place].store((k * size + i) as u32, Relaxed);
+            }
         }
+    });
+    let groups = chunks::fill(groups, threads, |g| {
+        let mut group: [u32; 4] = core::array::from_fn(|i| out[4 * g + i].load(Relaxed));
+        group.sort_unstable();
+        group
+    });
+    (groups, slot)
+}
+
+/// Adds `n` to `count` (wrapping), returning the count before: as one atomic step on threads,
+/// as a plain load and store on one, where the work runs as one chunk on this thread alone and
+/// an atomic read-modify-write would cost tens of cycles for nothing.
+fn add(count: &AtomicU8, n: u8, threads: usize) -> u8 {
+    if threads == 1 {
+        let c = count.load(Relaxed);
+        count.store(c.wrapping_add(n), Relaxed);
+        c
+    } else {
+        count.fetch_add(n, Relaxed)
     }
-    out
 }
 
 /// The two triangles replacing the four ears `[back, grey, forward]` around a grey vertex, split
@@ -176,128 +228,63 @@ fn blocks<L: Label>(grid: &Padded<'_, L>, p: [usize; 3], axis: usize, w: L) -> b
     }
 }
 
-/// Drops the marked vertices and triangles, renumbering the vertices in their order; returns
-/// the new ids. Runs in chunks, on threads unless one was asked for: each chunk keeps its own
-/// items at its start, then the chunks' kept runs are moved down into place in order.
-fn compact<L: Copy + Send + Sync>(
+/// Drops the vertices marked gone and the triangles whose fate is [`GONE`], puts `merged_pair`
+/// of each triangle replaced (and its fate's `r`) in its place, and renumbers the vertices in
+/// their order; returns the new ids. Runs in chunks, on threads unless one was asked for: each
+/// chunk keeps its own items at its start, then the chunks' kept runs are gathered.
+fn compact<L: Label>(
     atlas: &mut Atlas<L>,
-    gone_vertex: &[bool],
-    gone_triangle: &[bool],
+    gone_vertex: &[AtomicBool],
+    fate: &[AtomicU8],
+    merged_pair: impl Fn(&[u32; 3], u8) -> [u32; 3] + Sync,
     threads: usize,
 ) -> Vec<u32> {
-    let chunk = |n: usize| match threads {
-        1 => n.max(1),
-        _ => n.div_ceil(64).max(1 << 10),
-    };
     // Vertices: each chunk's first new id is the number kept before it.
-    let size = chunk(gone_vertex.len());
-    let before = offsets(&map_chunks(gone_vertex, size, |gone| {
-        gone.iter().filter(|&&g| !g).count()
-    }));
-    let mut new_id = vec![u32::MAX; gone_vertex.len()];
-    let kept = map_chunks_mut(
-        &mut atlas.positions,
-        &mut new_id,
-        gone_vertex,
-        size,
-        |k, p, ids, gone| {
-            let mut n = 0;
-            for v in 0..p.len() {
-                if !gone[v] {
-                    ids[v] = (before[k] + n) as u32;
-                    p[n] = p[v];
-                    n += 1;
-                }
-            }
-            n
-        },
-    );
-    gather(&mut atlas.positions, size, &kept);
-    let size = chunk(gone_triangle.len());
-    let (triangles, pairs) = (&mut atlas.triangles, &mut atlas.pairs);
-    let kept = map_chunks_mut(triangles, pairs, gone_triangle, size, |_, t, p, gone| {
+    let size = chunks::size(gone_vertex.len(), threads);
+    let kept = chunks::map(gone_vertex.chunks(size).collect(), |gone| {
+        gone.iter().filter(|g| !g.load(Relaxed)).count()
+    });
+    let mut new_id = chunks::fill(gone_vertex.len(), threads, |_| u32::MAX);
+    let jobs = atlas
+        .positions
+        .chunks_mut(size)
+        .zip(gone_vertex.chunks(size));
+    let jobs = jobs.zip(new_id.chunks_mut(size));
+    let jobs = jobs.zip(chunks::offsets(&kept)).collect();
+    chunks::map(jobs, |(((p, gone), ids), first)| {
         let mut n = 0;
-        for i in 0..t.len() {
-            if !gone[i] {
-                t[n] = t[i].map(|v| new_id[v as usize]);
-                p[n] = p[i];
+        for v in 0..p.len() {
+            if !gone[v].load(Relaxed) {
+                ids[v] = (first + n) as u32;
+                p[n] = p[v];
                 n += 1;
             }
         }
-        n
     });
-    gather(&mut atlas.triangles, size, &kept);
-    gather(&mut atlas.pairs, size, &kept);
+    chunks::gather(&mut atlas.positions, size, &kept, threads);
+    let size = chunks::size(fate.len(), threads);
+    let kept = chunks::map(fate.chunks(size).collect(), |fate| {
+        fate.iter().filter(|f| f.load(Relaxed) != GONE).count()
+    });
+    let jobs = atlas
+        .triangles
+        .chunks_mut(size)
+        .zip(atlas.pairs.chunks_mut(size));
+    let jobs = jobs.zip(fate.chunks(size)).collect();
+    chunks::map(jobs, |((t, p), fate)| {
+        let mut n = 0;
+        for i in 0..t.len() {
+            let kept = match fate[i].load(Relaxed) {
+                GONE => continue,
+                KEEP => t[i],
+                f => merged_pair(&t[i], f - REPLACED),
+            };
+            t[n] = kept.map(|v| new_id[v as usize]);
+            p[n] = p[i];
+            n += 1;
+        }
+    });
+    chunks::gather(&mut atlas.triangles, size, &kept, threads);
+    chunks::gather(&mut atlas.pairs, size, &kept, threads);
     new_id
-}
-
-/// The running sums before each count.
-fn offsets(counts: &[usize]) -> Vec<usize> {
-    counts
-        .iter()
-        .scan(0, |sum, &c| {
-            let at = *sum;
-            *sum += c;
-            Some(at)
-        })
-        .collect()
-}
-
-/// Moves the first `kept[k]` items of each chunk `k` of `size` items down after the previous
-/// chunks' kept items, and drops the rest.
-fn gather<T: Copy>(items: &mut Vec<T>, size: usize, kept: &[usize]) {
-    let mut to = 0;
-    for (k, &n) in kept.iter().enumerate() {
-        items.copy_within(k * size..k * size + n, to);
-        to += n;
-    }
-    items.truncate(to);
-}
-
-/// `f` of each chunk of `size` flags.
-#[cfg(feature = "std")]
-fn map_chunks(flags: &[bool], size: usize, f: impl Fn(&[bool]) -> usize + Sync) -> Vec<usize> {
-    use rayon::prelude::*;
-    flags.par_chunks(size).map(&f).collect()
-}
-
-/// `f` of each chunk of `size` flags.
-#[cfg(not(feature = "std"))]
-fn map_chunks(flags: &[bool], size: usize, f: impl Fn(&[bool]) -> usize) -> Vec<usize> {
-    flags.chunks(size).map(f).collect()
-}
-
-/// `f(k, a, b, flags)` of each chunk `k` of `size` items of the three lists alike.
-#[cfg(feature = "std")]
-fn map_chunks_mut<A: Send, B: Send>(
-    a: &mut [A],
-    b: &mut [B],
-    flags: &[bool],
-    size: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &[bool]) -> usize + Sync,
-) -> Vec<usize> {
-    use rayon::prelude::*;
-    a.par_chunks_mut(size)
-        .zip(b.par_chunks_mut(size))
-        .zip(flags.par_chunks(size))
-        .enumerate()
-        .map(|(k, ((a, b), g))| f(k, a, b, g))
-        .collect()
-}
-
-/// `f(k, a, b, flags)` of each chunk `k` of `size` items of the three lists alike.
-#[cfg(not(feature = "std"))]
-fn map_chunks_mut<A, B>(
-    a: &mut [A],
-    b: &mut [B],
-    flags: &[bool],
-    size: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &[bool]) -> usize,
-) -> Vec<usize> {
-    a.chunks_mut(size)
-        .zip(b.chunks_mut(size))
-        .zip(flags.chunks(size))
-        .enumerate()
-        .map(|(k, ((a, b), g))| f(k, a, b, g))
-        .collect()
 }

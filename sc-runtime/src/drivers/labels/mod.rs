@@ -15,10 +15,13 @@ use hashbrown::{HashMap, HashSet};
 use crate::{Error, Mesh, Mode, Stats, Volume};
 
 mod blocks;
+mod chunks;
 mod join;
 mod merge;
 mod smooth;
 mod sweep;
+#[cfg(test)]
+mod tests;
 
 use core::ops::Range;
 
@@ -132,8 +135,8 @@ pub fn extract_labels<L: Label>(
         let (mut atlas, ears, mut edges, mut pinned) = join::join(pieces);
         atlas.stats.v13 = atlas.positions.len() as u64;
         atlas.stats.t13 = atlas.triangles.len() as u64;
-        if let Some((kept, _)) = merge::merge(&grid, params, ears, &mut atlas) {
-            renumber(&mut edges, &mut pinned, &kept);
+        if let Some(merged) = merge::merge(&grid, params, ears, &mut atlas) {
+            renumber(&mut edges, &mut pinned, &merged.kept);
         }
         if params.smoothing > 0.0 {
             smooth::place(&grid, params, &mut atlas.positions, &edges, &pinned);
@@ -309,41 +312,22 @@ impl<L> Default for Atlas<L> {
 }
 
 impl<L: Label> Atlas<L> {
-    /// The labels with a surface, ascending, without the background (`background`).
-    pub fn labels(&self, background: L) -> Vec<L> {
-        // Neighbouring triangles often share their pair, and labels are mostly small integers,
-        // which a table marks as met; larger ones (a connectomics volume's ids) go in a set.
-        let mut labels: Vec<L> = Vec::new();
-        let mut met: Vec<bool> = Vec::new();
-        let mut large: HashSet<L> = HashSet::new();
-        let mut last = None;
-        for &pair in &self.pairs {
-            if last == Some(pair) {
-                continue;
-            }
-            last = Some(pair);
-            for l in pair {
-                match l.index().filter(|&i| i < 1 << 16) {
-                    Some(i) => {
-                        if i >= met.len() {
-                            met.resize(i + 1, false);
-                        }
-                        if !met[i] {
-                            met[i] = true;
-                            labels.push(l);
-                        }
-                    }
-                    None => {
-                        if large.insert(l) {
-                            labels.push(l);
-                        }
-                    }
-                }
-            }
+    /// The labels with a surface, ascending, without the background (`background`). Found on
+    /// `threads` threads (0 for all, 1 for the calling thread alone; the labels do not depend on
+    /// it); where a pool cannot be started, on this thread.
+    pub fn labels(&self, background: L, threads: usize) -> Vec<L> {
+        let n = self.pairs.len();
+        #[cfg(not(feature = "std"))]
+        let _ = threads;
+        #[cfg(feature = "std")]
+        if threads != 1
+            && let Ok(labels) = on_threads(threads, || {
+                labels_of(&self.pairs, chunks::size(n, threads), background)
+            })
+        {
+            return labels;
         }
-        labels.sort_unstable();
-        labels.retain(|&l| l != background);
-        labels
+        labels_of(&self.pairs, n.max(1), background)
     }
 
     /// One closed mesh per label of `labels` (ascending, as [`Atlas::labels`] gives them), each
@@ -456,6 +440,51 @@ impl<L: Label> Atlas<L> {
             stats,
         }
     }
+}
+
+/// The labels of `pairs` but `background`, ascending: those of each chunk of `size` pairs, on
+/// the current pool, then joined.
+fn labels_of<L: Label>(pairs: &[[L; 2]], size: usize, background: L) -> Vec<L> {
+    let mut labels = chunks::map(pairs.chunks(size).collect(), labels_in).concat();
+    labels.sort_unstable();
+    labels.dedup();
+    labels.retain(|&l| l != background);
+    labels
+}
+
+/// The labels of `pairs`, each once, in no order.
+fn labels_in<L: Label>(pairs: &[[L; 2]]) -> Vec<L> {
+    // Neighbouring triangles often share their pair, and labels are mostly small integers,
+    // which a table marks as met; larger ones (a connectomics volume's ids) go in a set.
+    let mut labels: Vec<L> = Vec::new();
+    let mut met: Vec<bool> = Vec::new();
+    let mut large: HashSet<L> = HashSet::new();
+    let mut last = None;
+    for &pair in pairs {
+        if last == Some(pair) {
+            continue;
+        }
+        last = Some(pair);
+        for l in pair {
+            match l.index().filter(|&i| i < 1 << 16) {
+                Some(i) => {
+                    if i >= met.len() {
+                        met.resize(i + 1, false);
+                    }
+                    if !met[i] {
+                        met[i] = true;
+                        labels.push(l);
+                    }
+                }
+                None => {
+                    if large.insert(l) {
+                        labels.push(l);
+                    }
+                }
+            }
+        }
+    }
+    labels
 }
 
 /// Calls `side(i, triangle, first)` for each triangle and each of its labels that is
