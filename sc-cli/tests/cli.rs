@@ -97,6 +97,29 @@ fn demo_knot_prints_table1() {
     assert_eq!(entries(dir.path()), ["knot.ply"]);
 }
 
+/// Table 1's paper-mode count is meshed again beside any other mode, adaptive mode's options
+/// included (paper mode refuses them, so they must not be passed on).
+#[test]
+fn demo_knot_prints_table1_in_adaptive_mode_with_its_options() {
+    let dir = tempfile::tempdir().unwrap();
+    skelclimb()
+        .current_dir(dir.path())
+        .args([
+            "extract",
+            "--demo",
+            "knot",
+            "--mode",
+            "adaptive",
+            "--max-box",
+            "2",
+        ])
+        .args(["--allow-wrong-side", "-o", "knot.ply"])
+        .assert()
+        .success()
+        .stdout(contains("10,464").and(contains("Steps 1–4 (paper mode)")));
+    assert_eq!(entries(dir.path()), ["knot.ply"]);
+}
+
 #[test]
 fn every_format_round_trips_the_same_mesh() {
     let dir = tempfile::tempdir().unwrap();

@@ -304,10 +304,13 @@ fn paper_knot(
         _ if !is_paper_knot => Ok(None),
         _ if args.mode == Mode::Paper => Ok(Some(mesh.stats.triangles)),
         Volume::Whole(grid) => {
+            // Paper mode, without adaptive mode's options, which it refuses.
             let request = Request {
                 mode: Mode::Paper,
                 normals: false,
                 max_error: None,
+                max_box: None,
+                allow_wrong_side: false,
                 ..*request
             };
             Ok(Some(
