@@ -10,7 +10,7 @@ use alloc::borrow::Cow;
 use alloc::vec::Vec;
 use core::ops::Range;
 
-use super::{InOrder, LARGEST_BOX, run, unkey};
+use super::{InOrder, LARGEST_BOX, run, unkey, vertices};
 use crate::drivers::blocks::{BlockMesh, edge_key};
 use crate::drivers::keep_used;
 use crate::{Error, Params, Scalar, Stats, Volume};
@@ -80,7 +80,8 @@ pub(crate) fn extract_block<T: Scalar>(
         }
         Cow::Owned(cut)
     };
-    let run = run(&Volume::new(&data, dims)?, start, grid, params, &InOrder)?;
+    let volume = Volume::new(&data, dims)?;
+    let run = run(&volume, start, grid, params, &InOrder)?;
     let owned = |key: u64| {
         let c = unkey(key as usize, grid);
         (0..3).all(|d| cubes[d].contains(&c[d]))
@@ -115,10 +116,9 @@ pub(crate) fn extract_block<T: Scalar>(
             edge_key(grid, unkey((key / 3) as usize, grid), (key % 3) as usize)
         })
         .collect();
-    out.positions = kept.iter().map(|&v| rec.mesh.positions[v]).collect();
-    if !rec.mesh.normals.is_empty() {
-        out.normals = kept.iter().map(|&v| rec.mesh.normals[v]).collect();
-    }
+    let vertices = vertices(&volume, start, params, &kept)?;
+    out.positions = vertices.positions;
+    out.normals = vertices.normals;
     let count = |keys: &[u64], owned: &dyn Fn(u64) -> bool| {
         keys.iter().filter(|&&k| owned(k)).count() as u64
     };

@@ -29,14 +29,14 @@ use crate::kernel::adaptive::{
 };
 use crate::kernel::vertex::sample_crossing;
 use crate::mesh::OwnedScratch;
-use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Stats, Volume};
+use crate::{Error, ErrorBound, Mesh, Mode, Params, Scalar, Sink, Stats, Volume};
 
 pub(crate) mod blocks;
 mod merged;
 mod record;
 
-use merged::Units;
-use record::Recorded;
+use merged::Removed;
+use record::{Kept, Recorded};
 
 /// The bound adaptive mode holds when none is given: half the smallest spacing, in world units
 /// (half a voxel where the spacing is even).
@@ -102,10 +102,10 @@ pub(crate) fn extract<T: Scalar>(
 ) -> Result<Mesh, Error> {
     let dims = volume.dims();
     check(params, dims)?;
-    let run = run(volume, [0; 3], dims, params, spread)?;
-    let mut mesh = run.rec.mesh;
+    let mut run = run(volume, [0; 3], dims, params, spread)?;
+    let kept = keep_used(run.rec.edges.len(), &mut run.triangles);
+    let mut mesh = vertices(volume, [0; 3], params, &kept)?;
     mesh.triangles = run.triangles;
-    compact(&mut mesh);
     mesh.stats = Stats {
         v13: run.rec.edges.len() as u64,
         t13: run.rec.cubes.len() as u64,
@@ -115,6 +115,25 @@ pub(crate) fn extract<T: Scalar>(
         ..Stats::default()
     };
     Ok(mesh)
+}
+
+/// A triangle (Steps 1–3 vertex ids) with the key of the cube that owns it
+/// ([`Recorded::point_key`]), and its place in the list it is sorted in.
+#[derive(Clone, Copy)]
+pub(super) struct Owned {
+    owner: u64,
+    triangle: [u32; 3],
+    seq: u32,
+}
+
+impl Owned {
+    pub(super) fn new(owner: u64, triangle: [u32; 3]) -> Self {
+        Owned {
+            owner,
+            triangle,
+            seq: 0,
+        }
+    }
 }
 
 /// What [`run`] makes: the Steps 1–3 sweep (global edge and cube keys), the triangles over its
@@ -143,19 +162,20 @@ fn run<T: Scalar>(
     spread: &impl Spread,
 ) -> Result<Run, Error> {
     let dims = volume.dims();
+    // Edges and triangles only: positions, normals and values wait for the vertices the mesh
+    // keeps ([`vertices`]).
     let steps123 = Params {
-        mode: Mode::Steps123,
-        max_error: None,
-        max_box: None,
-        ..*params
+        normals: false,
+        values: false,
+        ..steps123(params)
     };
-    let rec = record(volume, at, &steps123, Recorded::new(grid))?;
+    let mut rec = record(volume, at, &steps123, Recorded::new(grid))?;
     let largest = params.max_box.unwrap_or(LARGEST_BOX);
     let levels = largest.ilog2() as usize;
     if !has_cubes(dims) || levels == 0 {
         // Unit cubes only: the Steps 1–3 mesh, each triangle its cube's.
         return Ok(Run {
-            triangles: rec.mesh.triangles.clone(),
+            triangles: rec.triangles.clone(),
             owners: rec.cubes.clone(),
             merges: Vec::new(),
             rec,
@@ -180,26 +200,44 @@ fn run<T: Scalar>(
         values: false,
         ..*params
     };
-    let merged = record(volume, at, &embedded, Recorded::without_positions(grid))?;
+    let removed = {
+        let mut removed = Removed::new(&rec);
+        sweep(volume, at, &embedded, &mut removed)?;
+        removed.finish()
+    };
     let grid = Grid::new(volume, at, grid, params.iso, &rec);
     let lattice = grid.decide(levels, &tolerance, spread);
     let units = match lattice.first() {
         Some((pairs, _)) => {
             let mut level = final_levels(&lattice);
             balance(&mut level, *pairs, dims);
-            grid.emit(&lattice, &level, &tolerance, &merged, spread)
+            grid.emit(&lattice, &level, &tolerance, &removed, spread)
         }
-        None => grid.emit_units(&merged, |_| false, &tolerance),
+        None => {
+            let mut triangles = Vec::new();
+            let merges = grid.emit_units(&removed, |_| false, &tolerance, &mut triangles);
+            (triangles, merges)
+        }
     };
     drop(grid);
-    drop(merged);
-    let Units {
-        mut triangles,
-        merges,
-    } = units;
-    // Stable: within an owner, the order the steps made them in, which no cut changes.
-    triangles.sort_by_key(|&(owner, _)| owner);
-    let (owners, triangles) = triangles.into_iter().unzip();
+    drop(removed);
+    // What is read from here on is the edges and the cubes: the Steps 1–3 triangles go first.
+    rec.triangles = Vec::new();
+    let (mut triangles, merges) = units;
+    // Within an owner, the order the steps made them in, which no cut changes. A stable sort
+    // would take a buffer as large as the list; the place in the list, kept in the padding,
+    // makes an unstable one give the same order in place.
+    match u32::try_from(triangles.len()) {
+        Ok(_) => {
+            for (seq, t) in triangles.iter_mut().enumerate() {
+                t.seq = seq as u32;
+            }
+            triangles.sort_unstable_by_key(|t| (t.owner, t.seq));
+        }
+        Err(_) => triangles.sort_by_key(|t| t.owner),
+    }
+    let owners = triangles.iter().map(|t| t.owner).collect();
+    let triangles = triangles.into_iter().map(|t| t.triangle).collect();
     Ok(Run {
         rec,
         triangles,
@@ -216,6 +254,43 @@ fn record<T: Scalar>(
     params: &Params,
     mut rec: Recorded,
 ) -> Result<Recorded, Error> {
+    sweep(volume, at, params, &mut rec)?;
+    rec.settle();
+    Ok(rec)
+}
+
+/// `params` for the Steps 1–3 sweep adaptive mode starts from.
+fn steps123(params: &Params) -> Params {
+    Params {
+        mode: Mode::Steps123,
+        max_error: None,
+        max_box: None,
+        ..*params
+    }
+}
+
+/// The positions (and normals and values, as `params` asks) of the Steps 1–3 vertices `kept`
+/// (ids, ascending) of `volume` at global index `at`, from a second Steps 1–3 sweep. Sweeping
+/// again costs a few milliseconds; holding every vertex's position and normal while the boxes
+/// are decided cost a fifth of adaptive mode's peak memory.
+fn vertices<T: Scalar>(
+    volume: &Volume<'_, T>,
+    at: [usize; 3],
+    params: &Params,
+    kept: &[usize],
+) -> Result<Mesh, Error> {
+    let mut sink = Kept::new(kept);
+    sweep(volume, at, &steps123(params), &mut sink)?;
+    Ok(sink.finish())
+}
+
+/// The sweep of `volume` (at global index `at`) under `params` into `sink`.
+fn sweep<T: Scalar>(
+    volume: &Volume<'_, T>,
+    at: [usize; 3],
+    params: &Params,
+    sink: &mut impl Sink,
+) -> Result<(), Error> {
     let mut scratch = OwnedScratch::new(volume.dims())?;
     sweep_at(
         &Binary::new(params),
@@ -223,10 +298,9 @@ fn record<T: Scalar>(
         at,
         params,
         scratch.lend(),
-        &mut rec,
+        sink,
     )?;
-    rec.settle();
-    Ok(rec)
+    Ok(())
 }
 
 /// A box on the lattice of its size: whether it may replace its cubes.
@@ -256,8 +330,8 @@ struct Grid<'a, T: Scalar> {
     local: [usize; 3],
     iso: f64,
     threshold: T::Threshold,
-    /// Vertex edge keys with their ids, sorted by key.
-    vertex_of: Vec<(u64, u32)>,
+    /// Per axis, the ids of the vertices on its edges, in key order.
+    by_axis: [Vec<u32>; 3],
     /// The Steps 1–3 triangles, and each one's cube and each vertex's edge.
     triangles: &'a [[u32; 3]],
     rec: &'a Recorded,
@@ -273,16 +347,22 @@ impl<'a, T: Scalar> Grid<'a, T> {
     ) -> Self {
         // The sweep makes each cube's triangles in turn, cubes in key order, so the triangles
         // of a cube are a run of `rec.cubes`, found by bisection with no sorted copy. Vertices
-        // come as the cubes first reach their edges, out of key order: each edge key with its
-        // vertex id, in key order.
+        // come a layer's z-edges, then the next plane's x- and y-edges, row by row: out of key
+        // order, but each axis's in key order. So a vertex is found by bisection over its
+        // axis's ids, 4 bytes a vertex, with no sort.
         debug_assert!(rec.cubes.is_sorted(), "Steps 1–3 triangles in cube order");
-        let mut vertex_of: Vec<(u64, u32)> = rec
-            .edges
-            .iter()
-            .enumerate()
-            .map(|(i, &k)| (k, i as u32))
-            .collect();
-        vertex_of.sort_unstable();
+        let mut by_axis: [Vec<u32>; 3] = Default::default();
+        for (i, &key) in rec.edges.iter().enumerate() {
+            if let Some(ids) = by_axis.get_mut((key % 3) as usize) {
+                ids.push(i as u32);
+            }
+        }
+        debug_assert!(
+            by_axis
+                .iter()
+                .all(|ids| ids.is_sorted_by_key(|&v| rec.edges[v as usize])),
+            "each axis's vertices in key order"
+        );
         Grid {
             data: volume.data(),
             dims: grid,
@@ -290,8 +370,8 @@ impl<'a, T: Scalar> Grid<'a, T> {
             local: volume.dims(),
             iso,
             threshold: T::threshold(iso),
-            vertex_of,
-            triangles: &rec.mesh.triangles,
+            by_axis,
+            triangles: &rec.triangles,
             rec,
         }
     }
@@ -312,11 +392,10 @@ impl<'a, T: Scalar> Grid<'a, T> {
 
     fn vertex_id(&self, lower: [usize; 3], axis: usize) -> Option<u32> {
         let key = 3 * self.key(lower) + axis as u64;
-        let i = self.vertex_of.partition_point(|&(k, _)| k < key);
-        self.vertex_of
-            .get(i)
-            .filter(|&&(k, _)| k == key)
-            .map(|&(_, id)| id)
+        let edge = |v: u32| self.rec.edges[v as usize];
+        let ids = self.by_axis.get(axis)?;
+        let i = ids.partition_point(|&v| edge(v) < key);
+        ids.get(i).copied().filter(|&v| edge(v) == key)
     }
 
     /// A vertex's place in grid steps, from its edge key.
@@ -438,24 +517,23 @@ impl<'a, T: Scalar> Grid<'a, T> {
         }
     }
 
-    /// The triangles with their owners: those of unit cubes outside boxes, then each box's,
-    /// size by size, in the variant its neighbours give it. `level` is the balanced size of the
+    /// The triangles with their owners: each box's, size by size, in the variant its
+    /// neighbours give it, then those of the unit cubes outside boxes. `level` is the balanced size of the
     /// box holding each pair of cubes (`final_levels`).
     fn emit(
         &self,
         lattice: &Lattice,
         level: &[u8],
         tolerance: &Tolerance,
-        merged: &Recorded,
+        removed: &[u32],
         spread: &impl Spread,
-    ) -> Units {
+    ) -> (Vec<Owned>, Vec<u64>) {
         let pairs = lattice[0].0;
         let in_box = |cube_key: u64| -> bool {
             let cube = unkey(cube_key as usize, self.dims);
             let pair: [usize; 3] = core::array::from_fn(|d| (cube[d] - self.at[d]) / 2);
             (0..3).all(|d| pair[d] < pairs[d]) && level[cell_index(pair, pairs)] > 0
         };
-        let mut out = self.emit_units(merged, in_box, tolerance);
         let mut parts = Vec::new();
         for (l, (cells, states)) in lattice.iter().enumerate() {
             parts.extend(spread.ranges(states.len(), |range| {
@@ -467,14 +545,16 @@ impl<'a, T: Scalar> Grid<'a, T> {
                 triangles
             }));
         }
-        // Room for the boxes' triangles at once: grown part by part, the list, the largest
-        // adaptive mode holds, would double past its size as it is copied.
-        out.triangles
-            .reserve_exact(parts.iter().map(Vec::len).sum());
+        // The boxes' triangles are the largest list adaptive mode holds: the first part becomes
+        // the output, so that it is not copied whole, and the units' triangles are added to it.
+        let mut parts = parts.into_iter();
+        let mut out = parts.next().unwrap_or_default();
+        out.reserve_exact(parts.as_slice().iter().map(Vec::len).sum());
         for part in parts {
-            out.triangles.extend(part);
+            out.extend(part);
         }
-        out
+        let merges = self.emit_units(removed, in_box, tolerance, &mut out);
+        (out, merges)
     }
 
     /// Pushes the triangles of the accepted box with lattice index `cell` at level `l` (side
@@ -486,7 +566,7 @@ impl<'a, T: Scalar> Grid<'a, T> {
         pairs: [usize; 3],
         tolerance: &Tolerance,
         buf: &mut PatchBuf,
-        out: &mut Vec<(u64, [u32; 3])>,
+        out: &mut Vec<Owned>,
     ) {
         let side = 1usize << l;
         let first = cell.map(|c| c * (side / 2));
@@ -516,32 +596,30 @@ impl<'a, T: Scalar> Grid<'a, T> {
         for tri in t.triangles() {
             let ids = tri.map(|v: Vertex| self.vertex_id(v.lower, v.axis));
             if let [Some(a), Some(b), Some(c)] = ids {
-                out.push((owner, [a, b, c]));
+                out.push(Owned::new(owner, [a, b, c]));
             }
         }
     }
 
-    /// The triangles of the unit cubes outside boxes, with embedded mode's merges where no box
-    /// is near ([`merged::unit_triangles`]).
+    /// Pushes the triangles of the unit cubes outside boxes onto `out`, with embedded mode's
+    /// merges where no box is near, and returns the merges' owners
+    /// ([`merged::unit_triangles`]).
     fn emit_units(
         &self,
-        merged: &Recorded,
+        removed: &[u32],
         in_box: impl Fn(u64) -> bool,
         tolerance: &Tolerance,
-    ) -> Units {
-        let id = |key: u64| {
-            let i = self.vertex_of.partition_point(|&(k, _)| k < key);
-            self.vertex_of[i].1
-        };
+        out: &mut Vec<Owned>,
+    ) -> Vec<u64> {
         let place = |key: u64| self.place(key);
         merged::unit_triangles(
             self.triangles,
             self.rec,
-            merged,
-            id,
+            removed,
             place,
             in_box,
             tolerance,
+            out,
         )
     }
 }
@@ -680,19 +758,4 @@ fn neighbour(cell: [usize; 3], face: usize, cells: [usize; 3]) -> Option<usize> 
         }
     }
     Some(cell_index(n, cells))
-}
-
-/// Drops the vertices no triangle uses, keeping the others' order.
-fn compact(mesh: &mut Mesh) {
-    let kept = keep_used(mesh.positions.len(), &mut mesh.triangles);
-    keep_column(&mut mesh.positions, &kept);
-    keep_column(&mut mesh.normals, &kept);
-    keep_column(&mut mesh.values, &kept);
-}
-
-/// Keeps the entries `kept` of a per-vertex column (empty when not asked for).
-fn keep_column<C: Copy>(column: &mut Vec<C>, kept: &[usize]) {
-    if !column.is_empty() {
-        *column = kept.iter().map(|&v| column[v]).collect();
-    }
 }
