@@ -3,7 +3,10 @@
 //! buffer is already the runtime's x-fastest layout, so it is borrowed as it is. This is the
 //! CLI's NumPy reader's convention.
 
-use numpy::{Element, PyArray1, PyArray2, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use numpy::{
+    Element, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -92,4 +95,21 @@ pub fn rows<'py, T: Element, const N: usize>(
 ) -> PyResult<Bound<'py, PyArray2<T>>> {
     let n = rows.len();
     PyArray1::from_vec(py, rows.into_flattened()).reshape([n, N])
+}
+
+/// The rows of a C-contiguous `(n, N)` array, borrowed.
+pub fn borrow_rows<'a, T: Element, const N: usize>(
+    array: &'a PyReadonlyArray2<'_, T>,
+    name: &str,
+) -> PyResult<&'a [[T; N]]> {
+    let shape = array.shape();
+    let flat = array
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name}: the array is not C-contiguous")))?;
+    match flat.as_chunks::<N>() {
+        (rows, []) if shape[1] == N => Ok(rows),
+        _ => Err(PyValueError::new_err(format!(
+            "{name}: expected shape (n, {N}), got {shape:?}"
+        ))),
+    }
 }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -15,8 +15,7 @@ use sc_io::volume::{Dtype, Endian, Grid, Linear, Sample, Samples};
 use sc_io::with_samples;
 use sc_io::write::{MeshFormat, MeshSlices, WriteOptions};
 
-use crate::errors;
-use crate::world;
+use crate::{convert, errors, world};
 
 /// Writes a mesh straight from its NumPy arrays (C-contiguous `(n, 3)` rows, borrowed, not
 /// copied); the format follows the extension (`.ply`, `.obj`, `.stl`, `.glb`) and `space`
@@ -41,10 +40,10 @@ pub fn save(
         ascii,
         space: world::space(space)?,
     };
-    let positions = rows(&vertices, "vertices")?;
-    let triangles = rows(&faces, "faces")?;
+    let positions = convert::borrow_rows(&vertices, "vertices")?;
+    let triangles = convert::borrow_rows(&faces, "faces")?;
     let normals = match &normals {
-        Some(n) => rows(n, "normals")?,
+        Some(n) => convert::borrow_rows(n, "normals")?,
         None => &[],
     };
     if !normals.is_empty() && normals.len() != positions.len() {
@@ -67,23 +66,6 @@ pub fn save(
     };
     py.detach(|| AtomicFile::create(&path)?.write_with(|out| format.write(mesh, &options, out)))
         .map_err(errors::io)
-}
-
-/// The rows of a C-contiguous `(n, 3)` array as triples, borrowed.
-fn rows<'a, T: numpy::Element>(
-    array: &'a PyReadonlyArray2<'_, T>,
-    name: &str,
-) -> PyResult<&'a [[T; 3]]> {
-    let shape = array.shape();
-    let flat = array
-        .as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{name}: the array is not C-contiguous")))?;
-    match flat.as_chunks::<3>() {
-        (rows, []) if shape[1] == 3 => Ok(rows),
-        _ => Err(PyValueError::new_err(format!(
-            "{name}: expected shape (n, 3), got {shape:?}"
-        ))),
-    }
 }
 
 /// Reads a volume file (NIfTI, NRRD, MetaImage, NumPy, a DICOM directory, raw with `dims` and

@@ -4,13 +4,13 @@
 
 use std::fmt::Display;
 
-use numpy::{Element, PyUntypedArray};
+use numpy::{Element, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArray};
 use pyo3::conversion::FromPyObjectOwned;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyDict, PyList, PyTuple};
 use sc_io::space::World;
-use sc_runtime::labels::{Atlas, Label, LabelParams, extract_labels};
+use sc_runtime::labels::{Atlas, AtlasView, Label, LabelParams, extract_labels};
 use sc_runtime::{Mesh, Volume};
 
 use crate::convert::{self, with_type};
@@ -22,10 +22,12 @@ pub const TYPES: &str = "uint8, uint16, uint32, uint64, int16 or int32";
 /// How many labels an error message lists before it only counts them.
 const LISTED: usize = 10;
 
-/// Meshes the regions of a contiguous 3-D integer array (axes, `spacing`, `origin`, `affine` and
-/// `space` as `extract` reads them). `selection`: the labels to mesh, each one with a surface,
-/// or every label but the background. Returns `(vertices, faces, face_labels, meshes, stats)`:
-/// the atlas, then `(label, vertices, faces, normals or None, stats)` per label meshed, ascending.
+/// The atlas of a contiguous 3-D integer array (axes, `spacing`, `origin`, `affine` and `space`
+/// as `extract` reads them), and the labels to mesh: those of `selection`, each one with a
+/// surface, or every label but the background. Returns
+/// `(vertices, faces, face_labels, chosen, cut, stats)`: the atlas, the chosen labels (ascending,
+/// of the atlas's label type), and `(normals, threads, mode, space)`, the rest of what
+/// [`label_meshes`] cuts their meshes with.
 #[pyfunction]
 #[pyo3(signature = (volume, spacing, origin, background, mode, pad, normals, threads, smoothing, selection=None, affine=None, space=None))]
 #[allow(clippy::too_many_arguments)]
@@ -157,7 +159,8 @@ pub struct Reply<'a, 'py, L> {
 }
 
 /// [`labels`]'s result from an atlas made at `index × spacing + origin`, however it was made
-/// (in one sweep, or joined from blocks).
+/// (in one sweep, or joined from blocks): the atlas placed in the world, and the labels chosen,
+/// whose meshes [`label_meshes`] cuts from the placed atlas when they are asked for.
 pub fn respond<'py, L>(
     py: Python<'py>,
     mut atlas: Atlas<L>,
@@ -166,8 +169,7 @@ pub fn respond<'py, L>(
 where
     L: Label + Element + Display + FromPyObjectOwned<'py> + IntoPyObject<'py>,
 {
-    let (world, background, mode_name, normals) =
-        (&reply.world, reply.background, reply.mode, reply.normals);
+    let (world, background, mode_name) = (&reply.world, reply.background, reply.mode);
     if !world.is_translation() {
         py.detach(|| place(world, &mut atlas));
     }
@@ -176,43 +178,103 @@ where
         background,
         reply.selection,
     )?;
-    let meshes = py.detach(|| atlas.meshes(&chosen, normals, reply.threads));
 
     let stats = PyDict::new(py);
     stats.set_item("dims", reply.dims)?;
     stats.set_item("background", background)?;
     extract::report(&stats, &atlas.stats, mode_name, world.space)?;
-    let per_label = meshes
-        .into_iter()
-        .map(|(label, mesh)| {
-            let counts = PyDict::new(py);
-            counts.set_item("vertices", mesh.stats.vertices)?;
-            counts.set_item("triangles", mesh.stats.triangles)?;
-            let s = PyDict::new(py);
-            s.set_item("label", label)?;
-            s.set_item("mode", mode_name)?;
-            s.set_item("space", world.space.map(|s| s.name()))?;
-            s.set_item("result", counts)?;
-            let vertex_normals = match normals {
-                true => Some(convert::rows(py, mesh.normals)?),
-                false => None,
-            };
-            (
-                label,
-                convert::rows(py, mesh.positions)?,
-                convert::rows(py, mesh.triangles)?,
-                vertex_normals,
-                s,
-            )
-                .into_pyobject(py)
-        })
-        .collect::<PyResult<Vec<_>>>()?;
+    let cut = (
+        reply.normals,
+        reply.threads,
+        mode_name,
+        world.space.map(|s| s.name()),
+    );
     (
         convert::rows(py, atlas.positions)?,
         convert::rows(py, atlas.triangles)?,
         convert::rows(py, atlas.pairs)?,
-        per_label,
+        PyArray1::from_vec(py, chosen),
+        cut,
         stats,
+    )
+        .into_pyobject(py)
+}
+
+/// The meshes of the labels `chosen` (ascending), cut from the atlas `vertices`, `faces` and
+/// `face_labels` (borrowed, as [`labels`] returns them) on `threads` threads with the GIL
+/// released, each labelled with `mode` and `space`. Returns
+/// `(label, vertices, faces, normals or None, stats)` per label, in the order of `chosen`.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, face_labels, chosen, normals, threads, mode, space=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn label_meshes<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f32>,
+    faces: PyReadonlyArray2<'py, u32>,
+    face_labels: &Bound<'py, PyUntypedArray>,
+    chosen: &Bound<'py, PyUntypedArray>,
+    normals: bool,
+    threads: usize,
+    mode: &str,
+    space: Option<&str>,
+) -> PyResult<Bound<'py, PyList>> {
+    let positions = convert::borrow_rows(&vertices, "vertices")?;
+    let triangles = convert::borrow_rows(&faces, "faces")?;
+    with_type!(py, face_labels, "face_labels", TYPES, [u8, u16, u32, u64, i16, i32], L => {
+        let pairs = face_labels
+            .cast::<PyArray2<L>>()
+            .map_err(|_| PyValueError::new_err("face_labels: expected a (T, 2) array"))?
+            .try_readonly()
+            .map_err(|_| PyValueError::new_err("face_labels: the array is being written"))?;
+        let chosen = chosen
+            .cast::<PyArray1<L>>()
+            .map_err(|_| PyTypeError::new_err(format!(
+                "chosen: expected a 1-D array of face_labels' type ({})",
+                numpy::dtype::<L>(py)
+            )))?
+            .try_readonly()
+            .map_err(|_| PyValueError::new_err("chosen: the array is being written"))?;
+        let chosen = chosen
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("chosen: the array is not contiguous"))?;
+        let pairs = convert::borrow_rows(&pairs, "face_labels")?;
+        let atlas = AtlasView::new(positions, triangles, pairs).map_err(errors::runtime)?;
+        let meshes = py.detach(|| atlas.meshes(chosen, normals, threads));
+        let per_label = meshes
+            .into_iter()
+            .map(|(label, mesh)| mesh_tuple(py, label, mesh, normals, mode, space))
+            .collect::<PyResult<Vec<_>>>()?;
+        PyList::new(py, per_label)
+    })
+}
+
+/// A label's mesh as `(label, vertices, faces, normals or None, stats)`.
+fn mesh_tuple<'py, L: Copy + IntoPyObject<'py>>(
+    py: Python<'py>,
+    label: L,
+    mesh: Mesh,
+    normals: bool,
+    mode: &str,
+    space: Option<&str>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let counts = PyDict::new(py);
+    counts.set_item("vertices", mesh.stats.vertices)?;
+    counts.set_item("triangles", mesh.stats.triangles)?;
+    let s = PyDict::new(py);
+    s.set_item("label", label)?;
+    s.set_item("mode", mode)?;
+    s.set_item("space", space)?;
+    s.set_item("result", counts)?;
+    let vertex_normals = match normals {
+        true => Some(convert::rows(py, mesh.normals)?),
+        false => None,
+    };
+    (
+        label,
+        convert::rows(py, mesh.positions)?,
+        convert::rows(py, mesh.triangles)?,
+        vertex_normals,
+        s,
     )
         .into_pyobject(py)
 }

@@ -33,6 +33,7 @@ fn release_memory() -> usize {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(extract::extract, m)?)?;
     m.add_function(wrap_pyfunction!(labels::labels, m)?)?;
+    m.add_function(wrap_pyfunction!(labels::label_meshes, m)?)?;
     m.add_function(wrap_pyfunction!(skimage::skimage_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(files::save, m)?)?;
     m.add_function(wrap_pyfunction!(files::load, m)?)?;

@@ -20,6 +20,8 @@ MODES = ["embedded", "paper", "steps123"]
 
 def same(got, whole):
     """Equal vertex for vertex, triangle for triangle: the atlas, each label's mesh, the stats."""
+    # Every path to a result leaves its meshes to be cut when one is asked for.
+    assert got._meshes is None
     assert got.stats == whole.stats
     assert got.labels() == whole.labels()
     for name in ("vertices", "faces", "face_labels"):

@@ -113,6 +113,66 @@ def test_meshes_share_the_atlas_vertices():
         assert {tuple(p) for p in mesh.vertices.tolist()} <= atlas, label
 
 
+def cut(atlas, label, normals):
+    """`label`'s mesh cut from `atlas` in NumPy, as the runtime cuts it: the atlas's triangles
+    in order, those with the label second turned over, the vertices renumbered in order of
+    first use; normals the normalised float64 sums of the triangles' area normals."""
+    first, second = atlas.face_labels[:, 0] == label, atlas.face_labels[:, 1] == label
+    faces = np.where(second[:, None], atlas.faces[:, [0, 2, 1]], atlas.faces)[first | second]
+    used, at, local = np.unique(faces.ravel(), return_index=True, return_inverse=True)
+    order = np.argsort(at)
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    vertices = atlas.vertices[used[order]]
+    faces = rank[local].reshape(-1, 3).astype(np.uint32)
+    if not normals:
+        return vertices, faces, None
+    a, b, c = (vertices[faces[:, k]].astype(np.float64) for k in range(3))
+    sums = np.zeros((len(vertices), 3))
+    np.add.at(sums, faces.ravel(), np.repeat(np.cross(b - a, c - a), 3, axis=0))
+    length = np.sqrt((sums ** 2).sum(axis=1))[:, None]
+    unit = np.divide(sums, length, out=np.zeros_like(sums), where=length > 0)
+    return vertices, faces, unit.astype(np.float32)
+
+
+@pytest.mark.parametrize("normals", [True, False])
+def test_meshes_are_cut_once_when_first_asked_for(monkeypatch, normals):
+    """The call builds the atlas alone; the first mesh asked for cuts every label's, once, and
+    those are the bytes the atlas gives (labels converted from int64 and back, placed by an
+    affine that mirrors)."""
+    calls = []
+    native = skelclimb._labels._native.label_meshes
+
+    def counted(*args):
+        calls.append(args[3].tolist())
+        return native(*args)
+
+    monkeypatch.setattr(skelclimb._labels._native, "label_meshes", counted)
+    volume = cells((7, 8, 9), 7, 14).astype(np.int64) * 1000 - 3000
+    mirror = np.array([[0, 2, 0, 10], [2, 0, 0, 0], [0, 0, 2, 0], [0, 0, 0, 1]], dtype=float)
+    result = skelclimb.labels(volume, background=-3000, affine=mirror, space="LPS",
+                              normals=normals, threads=2)
+    present = sorted(set(np.unique(volume).tolist()) - {-3000})
+    assert result.labels() == list(result) == list(result.keys()) == present
+    assert len(result) == 6 and present[2] in result and 5 not in result and "0" not in result
+    with pytest.raises(KeyError, match=r"label 5 has no mesh here; meshed: -2000, -1000, 0, "):
+        result[5]
+    assert repr(result) == f"Labels(6 labels, {result.atlas!r})"
+    assert calls == [] and result._meshes is None
+    assert result.atlas.face_labels.dtype == np.int64
+    for label, mesh in result.items():
+        vertices, faces, normals_ = cut(result.atlas, label, normals)
+        assert mesh.vertices.tobytes() == vertices.tobytes(), label
+        assert mesh.faces.tobytes() == faces.tobytes(), label
+        assert (mesh.normals is None) == (normals_ is None)
+        assert normals_ is None or mesh.normals.tobytes() == normals_.tobytes(), label
+        assert mesh.stats == {"label": label, "mode": "embedded", "space": "LPS",
+                              "result": {"vertices": len(vertices), "triangles": len(faces)}}
+    assert [m.faces.tobytes() for m in result.values()] == [
+        result[label].faces.tobytes() for label in present]
+    assert calls == [present]
+
+
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("seed", range(4))
 def test_two_labels_give_extract_s_mesh_of_the_indicator(seed, mode):
@@ -242,7 +302,10 @@ def test_no_copy_of_a_contiguous_input():
 
 def test_the_gil_is_released():
     volume = np.random.default_rng(5).integers(0, 50, (96, 96, 96), dtype=np.uint16)
-    assert_gil_released(lambda: skelclimb.labels(volume, normals=False))
+    result = []
+    assert_gil_released(lambda: result.append(skelclimb.labels(volume, normals=False)))
+    # And while the meshes are cut, when the first is asked for.
+    assert_gil_released(lambda: result[0][1])
 
 
 # ---- selections ----

@@ -47,7 +47,8 @@ pub use mesh::Mesh;
 pub mod labels {
     #[cfg(feature = "alloc")]
     pub use crate::drivers::labels::{
-        Atlas, AtlasBlock, Label, LabelParams, block_samples, extract_block, extract_labels,
+        Atlas, AtlasBlock, AtlasView, Label, LabelParams, block_samples, extract_block,
+        extract_labels,
     };
     pub use crate::kernel::labels::*;
 }

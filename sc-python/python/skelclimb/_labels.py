@@ -47,6 +47,15 @@ class Labels(Mapping):
     A mapping from label (a Python ``int``) to that label's closed :class:`Mesh`, in ascending
     order of label: ``result[7]``, ``len(result)``, ``for label in result``, ``result.items()``.
 
+    The meshes are cut from the atlas the first time one is asked for (``result[7]``,
+    ``.items()``, ``.values()``, :meth:`to_pyvista`): every label's at once, with the GIL
+    released and the ``threads`` of the call, then kept. Until then a result holds only the
+    atlas, and :meth:`labels`, ``len``, ``in``, the keys, :attr:`atlas` and :attr:`stats` cut
+    nothing. The meshes share no memory with the atlas: together they hold up to twice its
+    triangles, as an interface between two labels is in both their meshes. They are cut from
+    the atlas's own arrays, so change those in place only after the meshes are cut, or on a
+    copy.
+
     Attributes
     ----------
     atlas : Atlas
@@ -58,35 +67,59 @@ class Labels(Mapping):
         ``background``.
     """
 
-    __slots__ = ("_meshes", "atlas", "stats")
+    __slots__ = ("_meshes", "_labels", "_keys", "_cut", "atlas", "stats")
 
-    def __init__(self, meshes, atlas, stats):
-        self._meshes = meshes
+    def __init__(self, atlas, stats, chosen, cut):
+        """``chosen``: the labels to mesh, ascending, as an array of the type the atlas was
+        swept in; ``cut``: the rest of ``_native.label_meshes``' arguments."""
         self.atlas = atlas
         self.stats = stats
+        self._labels = chosen.tolist()
+        self._keys = frozenset(self._labels)
+        self._cut = (atlas.vertices, atlas.faces, atlas.face_labels, chosen, cut)
+        self._meshes = None
+
+    def _built(self):
+        """The meshes by label, cut the first time they are asked for."""
+        if self._meshes is None:
+            vertices, faces, face_labels, chosen, cut = self._cut
+            # The labels' own type, if they were converted back to the volume's.
+            face_labels = face_labels.astype(chosen.dtype, copy=False)
+            meshes = _native.label_meshes(vertices, faces, face_labels, chosen, *cut)
+            self._meshes = {label: Mesh(v, f, n, s) for label, v, f, n, s in meshes}
+        return self._meshes
 
     def __getitem__(self, label):
         try:
-            return self._meshes[operator.index(label)]
-        except (TypeError, KeyError):
-            shown = ", ".join(map(str, list(self._meshes)[:10]))
-            more = ", …" if len(self._meshes) > 10 else ""
+            key = operator.index(label)
+        except TypeError:
+            key = None
+        if key not in self._keys:
+            shown = ", ".join(map(str, self._labels[:10]))
+            more = ", …" if len(self._labels) > 10 else ""
             raise KeyError(
                 f"label {label!r} has no mesh here; meshed: {shown or 'none'}{more}"
-            ) from None
+            )
+        return self._built()[key]
+
+    def __contains__(self, label):
+        try:
+            return operator.index(label) in self._keys
+        except TypeError:
+            return False
 
     def __iter__(self):
-        return iter(self._meshes)
+        return iter(self._labels)
 
     def __len__(self):
-        return len(self._meshes)
+        return len(self._labels)
 
     def __repr__(self):
         return f"Labels({len(self)} labels, {self.atlas!r})"
 
     def labels(self):
-        """The labels meshed, ascending."""
-        return list(self._meshes)
+        """The labels meshed, ascending (known from the atlas: no mesh is cut for them)."""
+        return list(self._labels)
 
     def to_pyvista(self):
         """The meshes as a ``pyvista.MultiBlock``, one block per label, named by the label
@@ -94,7 +127,7 @@ class Labels(Mapping):
         import pyvista
 
         blocks = pyvista.MultiBlock()
-        for label, mesh in self._meshes.items():
+        for label, mesh in self._built().items():
             blocks.append(mesh.to_pyvista(), str(label))
         return blocks
 
@@ -209,7 +242,8 @@ def labels(
     normals : bool
         Per-vertex normals of each label's mesh, pointing out of the label (area-weighted).
     threads : int
-        Threads to mesh on, 0 (the default) for every core; the result does not depend on it.
+        Threads to build the atlas and cut the meshes on, 0 (the default) for every core; the
+        result does not depend on it.
     smoothing : float
         0 (the default) puts every vertex at the midpoint of its grid edge. A width in voxels
         (up to 4; 0.75 gives spheres their area within 1 %) slides each vertex along its own
@@ -220,7 +254,9 @@ def labels(
     -------
     Labels
         ``result[label]`` is that label's :class:`Mesh`; ``result.atlas`` holds every interface
-        once. The GIL is released while the meshes are built.
+        once. The call builds the atlas, with the GIL released; the meshes are cut from it the
+        first time one is asked for, all at once, again with the GIL released and ``threads``
+        (see :class:`Labels`). A selection is checked here, whether or not a mesh is asked for.
 
     Examples
     --------
@@ -250,12 +286,8 @@ def labels(
 
 def _result(native, dtype=None):
     """The :class:`Labels` of what ``_native.labels`` returns, its labels of ``dtype`` (by
-    default, of the type they come in)."""
-    verts, faces, face_labels, meshes, stats = native
+    default, of the type they come in); the meshes are cut when first asked for."""
+    verts, faces, face_labels, chosen, cut, stats = native
     if dtype is not None and face_labels.dtype != dtype:
         face_labels = face_labels.astype(dtype)
-    return Labels(
-        {label: Mesh(v, f, n, s) for label, v, f, n, s in meshes},
-        Atlas(verts, faces, face_labels),
-        stats,
-    )
+    return Labels(Atlas(verts, faces, face_labels), stats, chosen, cut)

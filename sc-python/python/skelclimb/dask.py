@@ -257,7 +257,8 @@ def labels(array, *, affine=None, space=None, spacing=None, origin=None, labels=
     Each task reads its chunk plus a halo (two samples before, three after; with
     ``smoothing``, one more than the Gaussian's reach ``ceil(3 * smoothing)`` when that is
     further) and meshes the cubes it owns into a share of the atlas; a tree of merges joins the
-    shares, and the meshes per label are cut from the joined atlas where the result is wanted.
+    shares, and the meshes per label are cut from the joined atlas where the result is wanted,
+    the first time one is asked for (as :class:`skelclimb.Labels` says).
 
     Parameters
     ----------

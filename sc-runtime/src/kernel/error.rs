@@ -61,6 +61,11 @@ pub enum Error {
         /// The broken rule, in words.
         what: &'static str,
     },
+    /// An atlas's arrays do not fit together: `what` says how.
+    AtlasMalformed {
+        /// The broken rule, in words.
+        what: &'static str,
+    },
     /// A label extraction's smoothing width is negative, not finite, or wider than
     /// [`MAX_SMOOTHING`](crate::labels::MAX_SMOOTHING) voxels.
     Smoothing,
@@ -132,6 +137,7 @@ impl fmt::Display for Error {
                 write!(f, "two block meshes both own cube {cube}")
             }
             Error::BlockMalformed { what } => write!(f, "the block mesh is malformed: {what}"),
+            Error::AtlasMalformed { what } => write!(f, "the atlas is malformed: {what}"),
             Error::Smoothing => write!(
                 f,
                 "the smoothing width is in voxels, from 0 (none) to {}",

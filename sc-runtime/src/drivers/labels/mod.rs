@@ -4,7 +4,7 @@
 //! [`extract_labels`] sweeps the volume cube by cube ([`sweep`]), then merges grey edges where
 //! the volume is locally two-labelled ([`merge`]). The result, an [`Atlas`], holds each
 //! interface once, tagged with its two labels; [`Atlas::meshes`] cuts it into one closed mesh
-//! per label. [`extract_block`] meshes one block of a volume into a share ([`blocks`]); shares
+//! per label, as [`AtlasView::meshes`] does from an atlas's arrays held elsewhere. [`extract_block`] meshes one block of a volume into a share ([`blocks`]); shares
 //! join into that same atlas.
 
 use alloc::vec;
@@ -336,6 +336,57 @@ impl<L: Label> Atlas<L> {
     /// normals in that mesh. Cut on `threads` threads (0 for all, 1 for the calling thread
     /// alone; the meshes do not depend on it); where a pool cannot be started, on this thread.
     pub fn meshes(&self, labels: &[L], normals: bool, threads: usize) -> Vec<(L, Mesh)> {
+        self.view().meshes(labels, normals, threads)
+    }
+
+    /// The atlas's arrays, borrowed.
+    pub fn view(&self) -> AtlasView<'_, L> {
+        AtlasView {
+            positions: &self.positions,
+            triangles: &self.triangles,
+            pairs: &self.pairs,
+        }
+    }
+}
+
+/// An atlas's positions, triangles and pairs, borrowed from wherever they are kept (the Python
+/// package holds them as NumPy arrays, and cuts the meshes only when one is asked for).
+#[derive(Clone, Copy, Debug)]
+pub struct AtlasView<'a, L> {
+    positions: &'a [[f32; 3]],
+    triangles: &'a [[u32; 3]],
+    pairs: &'a [[L; 2]],
+}
+
+impl<'a, L: Label> AtlasView<'a, L> {
+    /// The atlas of these arrays, as [`Atlas`]'s fields of the same names; refused
+    /// ([`Error::AtlasMalformed`]) unless every triangle has a pair and its vertices are among
+    /// `positions`.
+    pub fn new(
+        positions: &'a [[f32; 3]],
+        triangles: &'a [[u32; 3]],
+        pairs: &'a [[L; 2]],
+    ) -> Result<Self, Error> {
+        if pairs.len() != triangles.len() {
+            return Err(Error::AtlasMalformed {
+                what: "not one pair of labels per triangle",
+            });
+        }
+        let count = positions.len();
+        if triangles.iter().flatten().any(|&v| v as usize >= count) {
+            return Err(Error::AtlasMalformed {
+                what: "a triangle's vertex is not among the positions",
+            });
+        }
+        Ok(AtlasView {
+            positions,
+            triangles,
+            pairs,
+        })
+    }
+
+    /// [`Atlas::meshes`] of these arrays.
+    pub fn meshes(&self, labels: &[L], normals: bool, threads: usize) -> Vec<(L, Mesh)> {
         let find = Find::new(labels, self.triangles.len());
         #[cfg(not(feature = "std"))]
         let _ = threads;
@@ -527,13 +578,14 @@ impl<'a, L: Label> Find<'a, L> {
     /// The table is kept no longer than 2¹⁶ or `size` entries, whichever is more: a few
     /// lookups' worth of memory per triangle at most.
     fn new(labels: &'a [L], size: usize) -> Self {
-        let small = labels.first().and_then(|l| l.index()).is_some();
+        // Labels out of order must not index past the table, though they come ascending.
+        let small = labels.iter().all(|l| l.index().is_some());
         let mut find = Find {
             labels,
             table: Vec::new(),
             map: HashMap::new(),
         };
-        match labels.last().and_then(|l| l.index()) {
+        match labels.iter().filter_map(|l| l.index()).max() {
             Some(max) if small && max < size.max(1 << 16) => {
                 find.table = vec![u32::MAX; max + 1];
                 for (i, l) in labels.iter().enumerate() {

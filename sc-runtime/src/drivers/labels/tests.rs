@@ -5,8 +5,8 @@
 use alloc::format;
 use alloc::vec::Vec;
 
-use super::{Atlas, LabelParams, extract_labels};
-use crate::{Mode, Volume};
+use super::{Atlas, AtlasView, LabelParams, extract_labels};
+use crate::{Error, Mode, Volume};
 
 /// Cells around `seeds` pseudo-random points, labelled `scale` times their seed's index (0, the
 /// background, for the first), so that labels past 2¹⁶ take the hash set's path.
@@ -70,4 +70,36 @@ fn many_chunks_give_the_same_atlas_as_one() {
             }
         }
     }
+}
+
+#[test]
+fn a_view_of_the_arrays_cuts_the_atlas_s_meshes() {
+    let dims = [9, 10, 11];
+    let data = cells(dims, 9, 1);
+    let atlas = extract_labels(Volume::new(&data, dims).unwrap(), &LabelParams::default()).unwrap();
+    let labels = atlas.labels(0, 1);
+    assert_eq!(labels.len(), 8);
+    let view = AtlasView::new(&atlas.positions, &atlas.triangles, &atlas.pairs).unwrap();
+    for (normals, threads) in [(true, 1), (false, 2)] {
+        let meshes = view.meshes(&labels, normals, threads);
+        assert_eq!(meshes, atlas.meshes(&labels, normals, threads));
+        assert!(meshes.iter().all(|(_, m)| !m.triangles.is_empty()));
+    }
+    // Out of order, each label still gets its own mesh: nothing indexes past the lookup table.
+    let backwards: Vec<u32> = labels.iter().rev().copied().collect();
+    let mut reversed = view.meshes(&backwards, true, 1);
+    reversed.reverse();
+    assert_eq!(reversed, atlas.meshes(&labels, true, 1));
+
+    let short = &atlas.pairs[1..];
+    assert!(matches!(
+        AtlasView::new(&atlas.positions, &atlas.triangles, short),
+        Err(Error::AtlasMalformed { .. })
+    ));
+    let missing = &atlas.positions[..atlas.positions.len() - 1];
+    let err = AtlasView::new(missing, &atlas.triangles, &atlas.pairs).unwrap_err();
+    assert_eq!(
+        format!("{err}"),
+        "the atlas is malformed: a triangle's vertex is not among the positions"
+    );
 }
