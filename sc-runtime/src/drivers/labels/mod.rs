@@ -4,8 +4,9 @@
 //! [`extract_labels`] sweeps the volume cube by cube ([`sweep`]), then merges grey edges where
 //! the volume is locally two-labelled ([`merge`]). The result, an [`Atlas`], holds each
 //! interface once, tagged with its two labels; [`Atlas::meshes`] cuts it into one closed mesh
-//! per label, as [`AtlasView::meshes`] does from an atlas's arrays held elsewhere. [`extract_block`] meshes one block of a volume into a share ([`blocks`]); shares
-//! join into that same atlas.
+//! per label, as [`AtlasView::meshes`] does from an atlas's arrays held elsewhere.
+//! [`extract_block`] meshes one block of a volume into a share ([`blocks`]); shares join into
+//! that same atlas.
 
 use alloc::vec;
 use alloc::vec::Vec;
