@@ -19,6 +19,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use core::ops::Range;
 
+use crate::drivers::blocks::edge_key;
 use crate::drivers::borrowed::sweep_at;
 use crate::drivers::{has_cubes, keep_used};
 use crate::kernel::Binary;
@@ -219,7 +220,6 @@ fn run<T: Scalar>(
             (triangles, merges)
         }
     };
-    drop(grid);
     drop(removed);
     // What is read from here on is the edges and the cubes: the Steps 1–3 triangles go first.
     rec.triangles = Vec::new();
@@ -330,8 +330,6 @@ struct Grid<'a, T: Scalar> {
     local: [usize; 3],
     iso: f64,
     threshold: T::Threshold,
-    /// Per axis, the ids of the vertices on its edges, in key order.
-    by_axis: [Vec<u32>; 3],
     /// The Steps 1–3 triangles, and each one's cube and each vertex's edge.
     triangles: &'a [[u32; 3]],
     rec: &'a Recorded,
@@ -345,23 +343,14 @@ impl<'a, T: Scalar> Grid<'a, T> {
         iso: f64,
         rec: &'a Recorded,
     ) -> Self {
-        // The sweep makes each cube's triangles in turn, cubes in key order, so the triangles
-        // of a cube are a run of `rec.cubes`, found by bisection with no sorted copy. Vertices
-        // come a layer's z-edges, then the next plane's x- and y-edges, row by row: out of key
-        // order, but each axis's in key order. So a vertex is found by bisection over its
-        // axis's ids, 4 bytes a vertex, with no sort.
+        // The sweep makes each cube's triangles in turn, cubes in key order, and sends the
+        // vertices in the order blocks name them by (`edge_key`): a cube's triangles are a run
+        // of `rec.cubes`, and a vertex is found, by bisection over `rec.edges`, with no sorted
+        // copy of either.
         debug_assert!(rec.cubes.is_sorted(), "Steps 1–3 triangles in cube order");
-        let mut by_axis: [Vec<u32>; 3] = Default::default();
-        for (i, &key) in rec.edges.iter().enumerate() {
-            if let Some(ids) = by_axis.get_mut((key % 3) as usize) {
-                ids.push(i as u32);
-            }
-        }
         debug_assert!(
-            by_axis
-                .iter()
-                .all(|ids| ids.is_sorted_by_key(|&v| rec.edges[v as usize])),
-            "each axis's vertices in key order"
+            rec.edges.is_sorted_by_key(|&k| sweep_order(k, grid)),
+            "Steps 1–3 vertices in the order of their edge_key"
         );
         Grid {
             data: volume.data(),
@@ -370,7 +359,6 @@ impl<'a, T: Scalar> Grid<'a, T> {
             local: volume.dims(),
             iso,
             threshold: T::threshold(iso),
-            by_axis,
             triangles: &rec.triangles,
             rec,
         }
@@ -391,11 +379,11 @@ impl<'a, T: Scalar> Grid<'a, T> {
     }
 
     fn vertex_id(&self, lower: [usize; 3], axis: usize) -> Option<u32> {
-        let key = 3 * self.key(lower) + axis as u64;
-        let edge = |v: u32| self.rec.edges[v as usize];
-        let ids = self.by_axis.get(axis)?;
-        let i = ids.partition_point(|&v| edge(v) < key);
-        ids.get(i).copied().filter(|&v| edge(v) == key)
+        let want = edge_key(self.dims, lower, axis);
+        let edges = &self.rec.edges;
+        let i = edges.partition_point(|&k| sweep_order(k, self.dims) < want);
+        let found = edges.get(i).map(|&k| sweep_order(k, self.dims));
+        (found == Some(want)).then_some(i as u32)
     }
 
     /// A vertex's place in grid steps, from its edge key.
@@ -711,6 +699,11 @@ fn across(first: [usize; 3], span: usize, face: usize, pairs: [usize; 3]) -> Opt
         p[axis] = p[axis].checked_sub(1)?;
     }
     Some(cell_index(p, pairs))
+}
+
+/// A record's edge key ([`Recorded::point_key`] based) as the sweep orders its vertices.
+fn sweep_order(key: u64, dims: [usize; 3]) -> u64 {
+    edge_key(dims, unkey((key / 3) as usize, dims), (key % 3) as usize)
 }
 
 /// The point of a grid of `dims` with index `i`, x fastest.
