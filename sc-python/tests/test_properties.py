@@ -113,7 +113,10 @@ def test_the_streamer_gives_extract_s_mesh_or_a_documented_error(volume, level, 
     except DOCUMENTED:
         return
     check_mesh(m.vertices, m.faces, m.normals)
-    whole = skelclimb.extract(volume.astype(np.float64), level, spacing=spacing, origin=origin)
+    # The streamer took the slices along the first axis, as a C-ordered array's z; `extract`
+    # reads a Fortran-ordered array's axes as (x, y, z), so it is given the C-ordered copy.
+    whole = skelclimb.extract(np.ascontiguousarray(volume, dtype=np.float64), level,
+                              spacing=spacing, origin=origin)
     assert np.array_equal(whole.faces, m.faces) and np.array_equal(whole.vertices, m.vertices)
 
 
