@@ -10,8 +10,8 @@
 //! Of embedded mode's sweep only the vertices its merges removed are kept ([`Removed`]): the
 //! rest follows from the Steps 1–3 mesh. A removed vertex's fan is the four triangles around it,
 //! and the two triangles replacing them split the fan's ring along the diagonal SPEC §5 chooses
-//! ([`Merge::pair`]). Holding embedded mode's mesh and matching its triangles to the fans took
-//! a third of adaptive mode's peak memory.
+//! ([`Merge::pair`]). Holding embedded mode's mesh, and matching its triangles to the fans, would
+//! take a third of adaptive mode's peak memory.
 
 use alloc::vec::Vec;
 
@@ -25,9 +25,8 @@ use crate::kernel::adaptive::checks::{scaled, within};
 /// 1–3's vertices in the same order, less those (a merged grey edge's vertex is never made), so
 /// one pass along Steps 1–3's edge keys finds them.
 pub(super) struct Removed<'a> {
-    /// Steps 1–3's edge keys, in the order its sweep sent them.
-    steps: &'a [u64],
-    dims: [usize; 3],
+    /// Steps 1–3's record: its edge keys come in the order its sweep sent them.
+    steps: &'a Recorded,
     /// The next Steps 1–3 vertex embedded mode may send.
     next: usize,
     /// The ones it skipped, ascending.
@@ -40,8 +39,7 @@ pub(super) struct Removed<'a> {
 impl<'a> Removed<'a> {
     pub fn new(steps: &'a Recorded) -> Self {
         Removed {
-            steps: &steps.edges,
-            dims: steps.dims,
+            steps,
             next: 0,
             ids: Vec::new(),
             lost: false,
@@ -49,7 +47,7 @@ impl<'a> Removed<'a> {
     }
 
     fn sent(&mut self, key: u64) {
-        while let Some(&k) = self.steps.get(self.next) {
+        while let Some(&k) = self.steps.edges.get(self.next) {
             self.next += 1;
             if k == key {
                 return;
@@ -69,7 +67,7 @@ impl<'a> Removed<'a> {
             return Vec::new();
         }
         self.ids
-            .extend((self.next..self.steps.len()).map(|v| v as u32));
+            .extend((self.next..self.steps.edges.len()).map(|v| v as u32));
         self.ids.shrink_to_fit();
         self.ids
     }
@@ -82,8 +80,7 @@ impl Sink for Removed<'_> {
     }
 
     fn edge_vertex(&mut self, lower: [usize; 3], axis: usize, _: [f32; 3], _: Option<[f32; 3]>) {
-        let [nx, ny, _] = self.dims;
-        self.sent(3 * (lower[0] + nx * (lower[1] + ny * lower[2])) as u64 + axis as u64);
+        self.sent(3 * self.steps.point_key(lower) + axis as u64);
     }
 
     fn triangle(&mut self, _: [u32; 3]) {}

@@ -272,7 +272,7 @@ fn steps123(params: &Params) -> Params {
 /// The positions (and normals and values, as `params` asks) of the Steps 1–3 vertices `kept`
 /// (ids, ascending) of `volume` at global index `at`, from a second Steps 1–3 sweep. Sweeping
 /// again costs a few milliseconds; holding every vertex's position and normal while the boxes
-/// are decided cost a fifth of adaptive mode's peak memory.
+/// are decided would cost a fifth of adaptive mode's peak memory.
 fn vertices<T: Scalar>(
     volume: &Volume<'_, T>,
     at: [usize; 3],
