@@ -4,7 +4,7 @@
     SC_DATA_DIR=../shared/data python3 bench/label_patterns.py     # needs NumPy
 
 For each padded label volume, counts the surface cubes (two or more labels among the corners)
-that are binary, cone and hub cubes. The rules are written here again from docs/labels.md,
+that are binary cubes, cones (drawn from a face's centre or the cube's) and hubs. The rules are written here again from docs/labels.md,
 independently of the runtime; the exhaustive check of every labelling is the Rust test
 `every_labelling_of_a_cube` (tests/tests/labels.rs).
 """
@@ -46,7 +46,8 @@ def pieces(ls, rule):
 
 
 def kind(labels):
-    """'binary', 'cone' or 'hub' for a cube of two or more labels."""
+    """'binary', 'cone from a face', 'cone from the centre' or 'hub' for a cube of two or more
+    labels."""
     rules = [split([labels[c] for c in f]) for f in FACES]
     for w in sorted(set(labels)):
         if all(r[0] == "uniform" or (r[0] == "cut" and (r[1] == w or (r[2] and w in
@@ -77,7 +78,13 @@ def kind(labels):
         elif r[0] == "cut":
             sides += len(pieces(ls, r)) - 1
     connected = occupied + centres + regions == sides + 2
-    return "cone" if connected and one_per_label else "hub"
+    if not (connected and one_per_label):
+        return "hub"
+    # A face centre that every region touches has a side per region: the cone is drawn from it.
+    degrees = [sum(ls[i] != ls[(i + 1) % 4] for i in range(4))
+               for ls, r in (([labels[c] for c in f], r) for f, r in zip(FACES, rules))
+               if r[0] == "centre"]
+    return "cone from a face" if regions in degrees else "cone from the centre"
 
 
 def census():
@@ -102,7 +109,7 @@ def census():
             counts[cache[key]] += 1
         total = sum(counts.values())
         print(f"{name}: {total} surface cubes, " + ", ".join(
-            f"{k} {100 * counts[k] / total:.2f} %" for k in ("binary", "cone", "hub")))
+            f"{k} {100 * counts[k] / total:.2f} %" for k in ("binary", "cone from a face", "cone from the centre", "hub")))
 
 
 if __name__ == "__main__":

@@ -402,15 +402,28 @@ impl Surface {
     }
 }
 
+/// The node a cone is drawn from instead of the cube's centre: the first face centre that every
+/// region touches (its sides number the regions), if any.
+///
+/// Seen from a point inside one face, the other five faces are each met once along every ray
+/// into the cube, so the cone from there over their sides is embedded as the centre's is; the
+/// sides through the apex, all on its own face, need no triangle, which saves one per region.
+/// Every region must touch the apex: a label reaching it at one point only would be pinched
+/// there when the cube across that face draws its cone from the same centre.
+fn cone_apex(sides: &[Side], regions: usize) -> Option<u8> {
+    (12..18u8).find(|&n| sides.iter().filter(|s| s.nodes.contains(&n)).count() == regions)
+}
+
 /// Builds a junction cube ([`Kind::Junction`]) into `out`.
 ///
 /// When the sides form one connected graph on the cube's surface and every label holds one
-/// region of it, each region is a disk and the cube is cut by the cone from its centre over the
-/// sides: one triangle per side. Otherwise one label, the one on most corners, takes a hub,
+/// region of it, each region is a disk and the cube is cut by a cone over the sides: from a face
+/// centre every region touches ([`cone_apex`]), one triangle per side off that face, or else
+/// from the cube's centre, one triangle per side. Otherwise one label, the one on most corners, takes a hub,
 /// the cube shrunk by half about its centre, and every region of another label becomes the slab
 /// between its part of the surface and the hub's: walls of two triangles over each side, and a
-/// floor. Both are radial from the centre, so their triangles cannot cross, wherever the nodes
-/// lie on their edges.
+/// floor. Both are radial from a point that sees each face's sides once, so their triangles
+/// cannot cross, wherever the nodes lie on their edges.
 pub fn junction<K: Ord + Copy>(keys: &[K; 8], out: &mut Junction) {
     out.len = 0;
     let mut s = Surface::new(keys);
@@ -443,10 +456,16 @@ pub fn junction<K: Ord + Copy>(keys: &[K; 8], out: &mut Junction) {
         }
     };
     if connected && one_per_label {
-        for side in &s.sides[..s.n_sides] {
+        let sides = &s.sides[..s.n_sides];
+        let apex = cone_apex(sides, regions);
+        for side in sides {
             let [a, b] = side.nodes;
+            if Some(a) == apex || Some(b) == apex {
+                continue;
+            }
+            let tip = apex.map_or(Local::Centre, node);
             out.push(
-                [Local::Centre, node(a), node(b)],
+                [tip, node(a), node(b)],
                 corner(side.to),
                 [side.from, side.to],
             );
