@@ -10,42 +10,27 @@ whose four cubes are all binary (today's merge candidates), those whose junction
 such cones with an ear at the edge (what merging across cones could add), and the rest. The cube
 rules are label_patterns.py's, written independently of the runtime.
 """
-import json
-import os
-
 import numpy as np
 
-from label_patterns import FACES, kind, split
+from label_patterns import apex_face, atlases, cube_corners, kind, pattern
 
 BINARY, FACE_CONE, OTHER = 1, 2, 3
-
-
-def apex(labels):
-    """The face a cone is drawn from: the first whose centre has a side per label."""
-    n = len(set(labels))
-    for f, face in enumerate(FACES):
-        ls = [labels[c] for c in face]
-        if split(ls)[0] == "centre" and sum(ls[i] != ls[(i + 1) % 4] for i in range(4)) == n:
-            return f
-    raise ValueError(f"{labels}: no face centre touches every region")
 
 
 def cubes(v):
     """Per cube (z, y, x): its construction, and for a cone drawn from a face, that face."""
     z, y, x = (n - 1 for n in v.shape)
-    corners = np.stack([v[a:a + z, b:b + y, c:c + x] for a in (0, 1) for b in (0, 1)
-                        for c in (0, 1)]).reshape(8, -1)
+    corners = cube_corners(v)
     code = np.zeros(z * y * x, np.int8)
     face = np.full(z * y * x, -1, np.int8)
     cache = {}
     for idx in np.nonzero(corners.min(0) != corners.max(0))[0]:
-        row = tuple(corners[:, idx])
-        order = sorted(set(row))
-        key = tuple(order.index(label) for label in row)
+        key = pattern(tuple(corners[:, idx]))
         if key not in cache:
             k = kind(list(key))
             cache[key] = ((BINARY, -1) if k == "binary" else
-                          (FACE_CONE, apex(list(key))) if k == "cone from a face" else (OTHER, -1))
+                          (FACE_CONE, apex_face(list(key))) if k == "cone from a face" else
+                          (OTHER, -1))
         code[idx], face[idx] = cache[key]
     return code.reshape(z, y, x), face.reshape(z, y, x)
 
@@ -85,13 +70,7 @@ def census(v):
 
 
 def main():
-    data = os.environ["SC_DATA_DIR"]
-    for name in ["aal-atlas", "jhu-wm-atlas", "itk-kmeans-seg"]:
-        folder = os.path.join(data, "labels", name)
-        meta = json.load(open(os.path.join(folder, name + ".json")))
-        nx, ny, nz = meta["dims"]
-        dtype = {"u8": np.uint8, "u16": np.uint16, "i16": np.int16, "u32": np.uint32}[meta["dtype"]]
-        v = np.pad(np.fromfile(os.path.join(folder, name + ".raw"), dtype).reshape(nz, ny, nx), 1)
+    for name, v in atlases():
         binary, across, rest = census(v)
         print(f"{name}: occupied grey edges, four binary cubes {binary}, binary cubes and cones "
               f"with an ear {across}, touching another junction cube {rest}")

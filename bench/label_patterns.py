@@ -80,14 +80,22 @@ def kind(labels):
     connected = occupied + centres + regions == sides + 2
     if not (connected and one_per_label):
         return "hub"
-    # A face centre that every region touches has a side per region: the cone is drawn from it.
-    degrees = [sum(ls[i] != ls[(i + 1) % 4] for i in range(4))
-               for ls, r in (([labels[c] for c in f], r) for f, r in zip(FACES, rules))
-               if r[0] == "centre"]
-    return "cone from a face" if regions in degrees else "cone from the centre"
+    return "cone from the centre" if apex_face(labels) is None else "cone from a face"
 
 
-def census():
+def apex_face(labels):
+    """The face a cone is drawn from: the first whose centre has a side per region (as each
+    label holds one region in a cone, a side per label), or None."""
+    for f, face in enumerate(FACES):
+        ls = [labels[c] for c in face]
+        if split(ls)[0] == "centre" and \
+                sum(ls[i] != ls[(i + 1) % 4] for i in range(4)) == len(set(labels)):
+            return f
+    return None
+
+
+def atlases():
+    """Each real label volume of $SC_DATA_DIR/labels, by name, padded by one background voxel."""
     import numpy as np
     data = os.environ["SC_DATA_DIR"]
     for name in ["aal-atlas", "jhu-wm-atlas", "itk-kmeans-seg"]:
@@ -95,21 +103,39 @@ def census():
         meta = json.load(open(os.path.join(folder, name + ".json")))
         nx, ny, nz = meta["dims"]
         dtype = {"u8": np.uint8, "u16": np.uint16, "i16": np.int16, "u32": np.uint32}[meta["dtype"]]
-        v = np.pad(np.fromfile(os.path.join(folder, name + ".raw"), dtype).reshape(nz, ny, nx), 1)
-        z, y, x = (n - 1 for n in v.shape)
-        corners = np.stack([v[a:a + z, b:b + y, c:c + x] for a in (0, 1) for b in (0, 1)
-                            for c in (0, 1)]).reshape(8, -1)
+        yield name, np.pad(np.fromfile(os.path.join(folder, name + ".raw"), dtype)
+                           .reshape(nz, ny, nx), 1)
+
+
+def cube_corners(v):
+    """The eight corner labels of every cube of `v` (axes z, y, x), as an (8, cubes) array."""
+    import numpy as np
+    z, y, x = (n - 1 for n in v.shape)
+    return np.stack([v[a:a + z, b:b + y, c:c + x] for a in (0, 1) for b in (0, 1)
+                     for c in (0, 1)]).reshape(8, -1)
+
+
+def pattern(row):
+    """A cube's corner labels renamed 0, 1, ... in ascending order: what its construction
+    depends on."""
+    order = sorted(set(row))
+    return tuple(order.index(label) for label in row)
+
+
+def census():
+    for name, v in atlases():
+        corners = cube_corners(v)
         surface = corners[:, corners.min(0) != corners.max(0)].T
         counts, cache = collections.Counter(), {}
         for row in map(tuple, surface):
-            order = sorted(set(row))
-            key = tuple(order.index(label) for label in row)
+            key = pattern(row)
             if key not in cache:
                 cache[key] = kind(list(key))
             counts[cache[key]] += 1
         total = sum(counts.values())
         print(f"{name}: {total} surface cubes, " + ", ".join(
-            f"{k} {100 * counts[k] / total:.2f} %" for k in ("binary", "cone from a face", "cone from the centre", "hub")))
+            f"{k} {100 * counts[k] / total:.2f} %"
+            for k in ("binary", "cone from a face", "cone from the centre", "hub")))
 
 
 if __name__ == "__main__":
