@@ -339,6 +339,8 @@ fn every_labelling_of_a_cube() {
     assert!(failures.is_empty(), "{failures:#?}");
     assert_eq!(counts.values().sum::<usize>(), 545_835);
     assert_eq!(counts["uniform"], 1);
+    // The crossing check above ran on some cones.
+    assert!(counts["cone from a face"] > 0, "{counts:?}");
     // Every two-label labelling (127 partitions in two blocks, both orders) is binary.
     assert!(counts["binary"] >= 254, "{counts:?}");
     eprintln!("{counts:?}");

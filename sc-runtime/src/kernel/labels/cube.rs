@@ -419,11 +419,11 @@ fn cone_apex(sides: &[Side], regions: usize) -> Option<u8> {
 /// When the sides form one connected graph on the cube's surface and every label holds one
 /// region of it, each region is a disk and the cube is cut by a cone over the sides: from a face
 /// centre every region touches ([`cone_apex`]), one triangle per side off that face, or else
-/// from the cube's centre, one triangle per side. Otherwise one label, the one on most corners, takes a hub,
-/// the cube shrunk by half about its centre, and every region of another label becomes the slab
-/// between its part of the surface and the hub's: walls of two triangles over each side, and a
-/// floor. Both are radial from a point that sees each face's sides once, so their triangles
-/// cannot cross, wherever the nodes lie on their edges.
+/// from the cube's centre, one triangle per side. Otherwise one label, the one on most corners,
+/// takes a hub, the cube shrunk by half about its centre, and every region of another label
+/// becomes the slab between its part of the surface and the hub's: walls of two triangles over
+/// each side, and a floor. Both are radial from a point that sees each face's sides once, so
+/// their triangles cannot cross, wherever the nodes lie on their edges.
 pub fn junction<K: Ord + Copy>(keys: &[K; 8], out: &mut Junction) {
     out.len = 0;
     let mut s = Surface::new(keys);
@@ -458,12 +458,12 @@ pub fn junction<K: Ord + Copy>(keys: &[K; 8], out: &mut Junction) {
     if connected && one_per_label {
         let sides = &s.sides[..s.n_sides];
         let apex = cone_apex(sides, regions);
+        let tip = apex.map_or(Local::Centre, node);
         for side in sides {
             let [a, b] = side.nodes;
             if Some(a) == apex || Some(b) == apex {
                 continue;
             }
-            let tip = apex.map_or(Local::Centre, node);
             out.push(
                 [tip, node(a), node(b)],
                 corner(side.to),
