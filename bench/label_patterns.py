@@ -4,9 +4,9 @@
     SC_DATA_DIR=../shared/data python3 bench/label_patterns.py     # needs NumPy
 
 For each padded label volume, counts the surface cubes (two or more labels among the corners)
-that are binary cubes, cones (drawn from a face's centre or the cube's) and hubs. The rules are written here again from docs/labels.md,
-independently of the runtime; the exhaustive check of every labelling is the Rust test
-`every_labelling_of_a_cube` (tests/tests/labels.rs).
+that are binary cubes, cones (drawn from a face's centre or the cube's) and hubs. The rules are
+written here again from docs/labels.md, independently of the runtime; the exhaustive check of
+every labelling is the Rust test `every_labelling_of_a_cube` (tests/tests/labels.rs).
 """
 import collections
 import json
